@@ -1,0 +1,121 @@
+"""Step-size control, kept apart from the stepper: norms, the controller, the first step.
+
+The controller never sees a tableau and the stepper never picks a step size (the diffrax
+split). Constants follow Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+
+
+def error_norm(
+    error: np.ndarray, y: np.ndarray, y_new: np.ndarray, rtol: float, atol: np.ndarray | float
+) -> float:
+    """Hairer's weighted root-mean-square norm of a local error estimate.
+
+    .. math::
+
+        \\|e\\| = \\sqrt{\\frac{1}{n} \\sum_i
+        \\Bigl(\\frac{e_i}{\\mathrm{atol}_i + \\mathrm{rtol}\\,\\max(|y_i|, |y^{new}_i|)}\\Bigr)^2}
+
+    A step is acceptable when the norm is at most 1.
+    """
+    scale = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
+    return float(np.sqrt(np.mean(np.square(error / scale))))
+
+
+@dataclass(frozen=True)
+class StepController:
+    """The classical (integral) step-size controller.
+
+    .. math::
+
+        h_{next} = h \\cdot \\min\\bigl(f_{max}, \\max(f_{min},
+        s \\cdot \\|e\\|^{-1/(q+1)})\\bigr)
+
+    with ``q`` the order of the error estimate. After a rejected step the step may not grow.
+
+    Parameters
+    ----------
+    safety : float
+        Safety factor ``s`` in (0, 1).
+    min_factor, max_factor : float
+        Bounds on the shrink and growth of one step.
+    """
+
+    safety: float = SAFETY
+    min_factor: float = MIN_FACTOR
+    max_factor: float = MAX_FACTOR
+
+    def propose(
+        self, h: float, error_norm: float, order: int, *, after_rejection: bool = False
+    ) -> tuple[bool, float]:
+        """Accept or reject a step and propose the next step size.
+
+        Parameters
+        ----------
+        h : float
+            The step just tried.
+        error_norm : float
+            Its weighted error norm (see :func:`error_norm`); NaN counts as infinite.
+        order : int
+            Order ``q`` of the error estimate.
+        after_rejection : bool
+            Whether the previous attempt at this step was rejected (then no growth).
+
+        Returns
+        -------
+        accepted : bool
+            ``error_norm <= 1``.
+        h_next : float
+            The step to try next: the following step if accepted, a retry if not.
+        """
+        accepted = bool(error_norm <= 1.0)
+        if not np.isfinite(error_norm):
+            return False, h * self.min_factor
+        if error_norm == 0.0:
+            factor = self.max_factor
+        else:
+            factor = self.safety * error_norm ** (-1.0 / (order + 1))
+        upper = 1.0 if (after_rejection or not accepted) else self.max_factor
+        factor = min(upper, max(self.min_factor, factor))
+        return accepted, h * factor
+
+
+def minimum_step(t: float) -> float:
+    """The smallest step that still moves ``t``: ten units in the last place."""
+    return 10.0 * float(np.abs(np.nextafter(t, np.inf) - t))
+
+
+def initial_step(
+    fun: Callable[[float, np.ndarray], np.ndarray],
+    t0: float,
+    y0: np.ndarray,
+    f0: np.ndarray,
+    order: int,
+    rtol: float,
+    atol: np.ndarray | float,
+) -> float:
+    """Choose a first step from the scale of ``y0``, ``f0`` and one trial Euler step.
+
+    Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4, algorithm (4.14). Costs one evaluation.
+    """
+    scale = atol + np.abs(y0) * rtol
+    d0 = np.sqrt(np.mean(np.square(y0 / scale)))
+    d1 = np.sqrt(np.mean(np.square(f0 / scale)))
+    h0 = 1e-6 if d0 < 1e-5 or d1 < 1e-5 else 0.01 * d0 / d1
+    f1 = fun(t0 + h0, y0 + h0 * f0)
+    d2 = np.sqrt(np.mean(np.square((f1 - f0) / scale))) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1))
+    return float(min(100 * h0, h1))

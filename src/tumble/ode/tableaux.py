@@ -1,0 +1,224 @@
+"""Butcher tableaux as data: every Runge–Kutta method tumble knows.
+
+A method is a :class:`ButcherTableau` constant; one stepper (:func:`tumble.ode.stepper.rk_step`)
+runs them all, on vector spaces, and the Runge–Kutta–Munthe-Kaas stepper of
+:mod:`tumble.rigid` runs the same data on SO(3). Adding a method costs a constant here and an
+entry in :data:`TABLEAUX`.
+
+For a tableau with stages ``s``, the step from ``(t, y)`` with step ``h`` is
+
+.. math::
+
+    k_i = f\\Bigl(t + c_i h,\\; y + h \\sum_{j<i} a_{ij} k_j\\Bigr), \\qquad
+    y_{n+1} = y + h \\sum_i b_i k_i,
+
+and, for an embedded pair, the error estimate is :math:`h \\sum_i (b_i - \\hat b_i) k_i`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+_TOL = 1e-14
+
+
+def _frozen(values, ndim: int) -> np.ndarray:
+    array = np.array(values, dtype=float, ndmin=ndim)
+    array.setflags(write=False)
+    return array
+
+
+@dataclass(frozen=True, eq=False)
+class ButcherTableau:
+    """An explicit Runge–Kutta method, checked on construction.
+
+    Parameters
+    ----------
+    name : str
+        The method's name in :func:`tumble.solve` (``method=name``).
+    c : array_like, shape (s,)
+        Nodes.
+    A : array_like, shape (s, s)
+        Strictly lower-triangular stage matrix.
+    b : array_like, shape (s,)
+        Weights of the propagated solution.
+    order : int
+        Classical order of the propagated solution.
+    b_hat : array_like, shape (s,), optional
+        Weights of the embedded solution; makes the method adaptive.
+    order_hat : int, optional
+        Order of the embedded solution.
+    fsal : bool
+        First same as last: the last stage is ``f(t + h, y_{n+1})`` (its row of ``A`` is ``b``).
+    dense : array_like, shape (s, q), optional
+        The method's own continuous extension: ``y(t + θh) = y + h Σ_i k_i Σ_j P_ij θ^(j+1)``.
+        Without it, dense output is the cubic Hermite interpolant.
+    reference : str
+        Where the coefficients come from.
+
+    Raises
+    ------
+    ValueError
+        If a row of ``A`` does not sum to its node, the weights do not sum to 1, the error
+        weights ``b - b_hat`` do not sum to 0, ``A`` is not strictly lower-triangular, or a
+        FSAL tableau's last row is not ``b``.
+    """
+
+    name: str
+    c: np.ndarray
+    A: np.ndarray
+    b: np.ndarray
+    order: int
+    b_hat: np.ndarray | None = None
+    order_hat: int | None = None
+    fsal: bool = False
+    dense: np.ndarray | None = None
+    reference: str = ""
+    e: np.ndarray | None = field(init=False, default=None)
+
+    def __post_init__(self) -> None:
+        set_ = object.__setattr__
+        set_(self, "c", _frozen(self.c, 1))
+        set_(self, "A", _frozen(self.A, 2))
+        set_(self, "b", _frozen(self.b, 1))
+        if self.b_hat is not None:
+            set_(self, "b_hat", _frozen(self.b_hat, 1))
+            set_(self, "e", _frozen(self.b - self.b_hat, 1))
+        if self.dense is not None:
+            set_(self, "dense", _frozen(self.dense, 2))
+        self._check()
+
+    def _check(self) -> None:
+        s = self.stages
+        if self.A.shape != (s, s) or self.b.shape != (s,):
+            raise ValueError(f"{self.name}: A must be ({s}, {s}) and b ({s},)")
+        if np.any(np.triu(self.A) != 0):
+            raise ValueError(f"{self.name}: A must be strictly lower-triangular (explicit)")
+        if not np.allclose(self.A.sum(axis=1), self.c, rtol=0, atol=_TOL):
+            raise ValueError(f"{self.name}: the rows of A must sum to c")
+        if abs(self.b.sum() - 1.0) > _TOL:
+            raise ValueError(f"{self.name}: the weights b must sum to 1, not {self.b.sum()!r}")
+        if self.e is not None and abs(self.e.sum()) > _TOL:
+            raise ValueError(f"{self.name}: the error weights b - b_hat must sum to 0")
+        if self.fsal and not (np.array_equal(self.A[-1], self.b) and self.c[-1] == 1.0):
+            raise ValueError(f"{self.name}: a FSAL tableau's last row of A must equal b")
+
+    @property
+    def stages(self) -> int:
+        """Number of stages ``s``."""
+        return self.c.shape[0]
+
+    @property
+    def adaptive(self) -> bool:
+        """Whether the tableau carries an embedded pair for error control."""
+        return self.e is not None
+
+    @property
+    def error_order(self) -> int:
+        """Order ``min(p, p̂)`` of the local error estimate, used by the step controller."""
+        if self.order_hat is None:
+            return self.order
+        return min(self.order, self.order_hat)
+
+    @property
+    def evaluations_per_step(self) -> int:
+        """Right-hand-side evaluations a step costs (FSAL saves one)."""
+        return self.stages - 1 if self.fsal else self.stages
+
+
+EULER = ButcherTableau(
+    name="euler", c=[0.0], A=[[0.0]], b=[1.0], order=1, reference="Euler (1768)."
+)
+
+HEUN = ButcherTableau(
+    name="heun",
+    c=[0.0, 1.0],
+    A=[[0.0, 0.0], [1.0, 0.0]],
+    b=[0.5, 0.5],
+    order=2,
+    reference="Heun (1900); the explicit trapezoidal rule.",
+)
+
+MIDPOINT = ButcherTableau(
+    name="midpoint",
+    c=[0.0, 0.5],
+    A=[[0.0, 0.0], [0.5, 0.0]],
+    b=[0.0, 1.0],
+    order=2,
+    reference="Runge (1895); the explicit midpoint rule.",
+)
+
+RK4 = ButcherTableau(
+    name="rk4",
+    c=[0.0, 0.5, 0.5, 1.0],
+    A=[[0, 0, 0, 0], [0.5, 0, 0, 0], [0, 0.5, 0, 0], [0, 0, 1.0, 0]],
+    b=[1 / 6, 1 / 3, 1 / 3, 1 / 6],
+    order=4,
+    reference="Kutta (1901); the classical fourth-order method.",
+)
+
+FEHLBERG45 = ButcherTableau(
+    name="rkf45",
+    c=[0, 1 / 4, 3 / 8, 12 / 13, 1, 1 / 2],
+    A=[
+        [0, 0, 0, 0, 0, 0],
+        [1 / 4, 0, 0, 0, 0, 0],
+        [3 / 32, 9 / 32, 0, 0, 0, 0],
+        [1932 / 2197, -7200 / 2197, 7296 / 2197, 0, 0, 0],
+        [439 / 216, -8, 3680 / 513, -845 / 4104, 0, 0],
+        [-8 / 27, 2, -3544 / 2565, 1859 / 4104, -11 / 40, 0],
+    ],
+    b=[25 / 216, 0, 1408 / 2565, 2197 / 4104, -1 / 5, 0],
+    order=4,
+    b_hat=[16 / 135, 0, 6656 / 12825, 28561 / 56430, -9 / 50, 2 / 55],
+    order_hat=5,
+    reference=(
+        "Fehlberg, E. (1969). Low-order classical Runge-Kutta formulas with stepsize control "
+        "and their application to some heat transfer problems. NASA TR R-315. The fourth-order "
+        "solution is propagated, as Fehlberg did."
+    ),
+)
+
+DORMAND_PRINCE54 = ButcherTableau(
+    name="dopri5",
+    c=[0, 1 / 5, 3 / 10, 4 / 5, 8 / 9, 1, 1],
+    A=[
+        [0, 0, 0, 0, 0, 0, 0],
+        [1 / 5, 0, 0, 0, 0, 0, 0],
+        [3 / 40, 9 / 40, 0, 0, 0, 0, 0],
+        [44 / 45, -56 / 15, 32 / 9, 0, 0, 0, 0],
+        [19372 / 6561, -25360 / 2187, 64448 / 6561, -212 / 729, 0, 0, 0],
+        [9017 / 3168, -355 / 33, 46732 / 5247, 49 / 176, -5103 / 18656, 0, 0],
+        [35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0],
+    ],
+    b=[35 / 384, 0, 500 / 1113, 125 / 192, -2187 / 6784, 11 / 84, 0],
+    order=5,
+    b_hat=[5179 / 57600, 0, 7571 / 16695, 393 / 640, -92097 / 339200, 187 / 2100, 1 / 40],
+    order_hat=4,
+    fsal=True,
+    dense=[
+        [1, -8048581381 / 2820520608, 8663915743 / 2820520608, -12715105075 / 11282082432],
+        [0, 0, 0, 0],
+        [0, 131558114200 / 32700410799, -68118460800 / 10900136933, 87487479700 / 32700410799],
+        [0, -1754552775 / 470086768, 14199869525 / 1410260304, -10690763975 / 1880347072],
+        [
+            0,
+            127303824393 / 49829197408,
+            -318862633887 / 49829197408,
+            701980252875 / 199316789632,
+        ],
+        [0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
+        [0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
+    ],
+    reference=(
+        "Dormand, J. R. & Prince, P. J. (1980). A family of embedded Runge-Kutta formulae. "
+        "J. Comp. Appl. Math. 6(1), 19-26; dense output of Shampine (1986), as in scipy's RK45."
+    ),
+)
+
+TABLEAUX: dict[str, ButcherTableau] = {
+    tableau.name: tableau for tableau in (EULER, HEUN, MIDPOINT, RK4, FEHLBERG45, DORMAND_PRINCE54)
+}
+"""Every tableau by its method name."""
