@@ -5,7 +5,8 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-dev
 BENCH_STAMP := $(VENV)/.installed-bench
-RUN_DIR ?= runs/t-handle
+DEMO ?= projectile
+RUN_DIR ?= runs/$(DEMO)
 
 .PHONY: demo test bench lint format clean
 
@@ -22,7 +23,7 @@ $(BENCH_STAMP): pyproject.toml $(STAMP)
 	touch $@
 
 demo: $(STAMP)
-	$(BIN)/tumble run t-handle --out $(RUN_DIR) --force
+	$(BIN)/tumble run $(DEMO) --out $(RUN_DIR) --force
 
 test: $(STAMP)
 	$(BIN)/python -m pytest

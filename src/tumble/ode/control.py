@@ -6,6 +6,7 @@ split). Constants follow Hairer, Nørsett & Wanner, *Solving ODEs I*, §II.4.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -28,8 +29,8 @@ def error_norm(
 
     A step is acceptable when the norm is at most 1.
     """
-    scale = atol + rtol * np.maximum(np.abs(y), np.abs(y_new))
-    return float(np.sqrt(np.mean(np.square(error / scale))))
+    scaled = error / (atol + rtol * np.maximum(np.abs(y), np.abs(y_new)))
+    return math.sqrt(float(scaled @ scaled) / scaled.size)
 
 
 @dataclass(frozen=True)
@@ -92,7 +93,7 @@ class StepController:
 
 def minimum_step(t: float) -> float:
     """The smallest step that still moves ``t``: ten units in the last place."""
-    return 10.0 * float(np.abs(np.nextafter(t, np.inf) - t))
+    return 10.0 * math.ulp(t)
 
 
 def initial_step(

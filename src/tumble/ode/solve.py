@@ -62,13 +62,15 @@ class OdeResult:
 
 
 class _CountedFunction:
+    """The user's right-hand side, counted; its first result's shape is checked."""
+
     def __init__(self, fun: Callable, n: int):
         self.fun, self.n, self.count = fun, n, 0
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
         self.count += 1
         f = np.asarray(self.fun(t, y), dtype=float)
-        if f.shape != (self.n,):
+        if self.count == 1 and f.shape != (self.n,):
             raise ValueError(f"fun(t, y) returned shape {f.shape}; expected ({self.n},)")
         return f
 
@@ -173,8 +175,8 @@ def _integrate_adaptive(
         h_min = minimum_step(run.t)
         t_new = min(run.t + max(h, h_min), t1)
         y_new, error = rk_step(run.fun, run.t, run.y, run.f, t_new - run.t, tableau, run.K)
-        finite = np.all(np.isfinite(y_new))
-        norm = error_norm(error, run.y, y_new, rtol, atol) if finite else math.inf
+        norm = error_norm(error, run.y, y_new, rtol, atol)  # nan/inf if y_new is not finite
+        finite = math.isfinite(norm)
         accepted, h = controller.propose(t_new - run.t, norm, order, after_rejection=rejected)
         if not accepted:
             run.n_rejected += 1

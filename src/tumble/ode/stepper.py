@@ -53,10 +53,9 @@ def rk_step(
         The local error estimate ``h Σ (b_i − b̂_i) k_i`` for an embedded pair, else None.
         For a FSAL tableau ``K[-1]`` then holds ``fun(t + h, y_new)``.
     """
-    A, c = tableau.A, tableau.c
     K[0] = f
-    for i in range(1, tableau.stages):
-        K[i] = fun(t + c[i] * h, y + h * (A[i, :i] @ K[:i]))
+    for i, (row, c) in enumerate(tableau.rows, start=1):
+        K[i] = fun(t + c * h, y + h * (row @ K[:i]))
     y_new = y + h * (tableau.b @ K)
     error = None if tableau.e is None else h * (tableau.e @ K)
     return y_new, error

@@ -77,6 +77,7 @@ class ButcherTableau:
     dense: np.ndarray | None = None
     reference: str = ""
     e: np.ndarray | None = field(init=False, default=None)
+    rows: tuple = field(init=False, default=(), repr=False)
 
     def __post_init__(self) -> None:
         set_ = object.__setattr__
@@ -89,6 +90,8 @@ class ButcherTableau:
         if self.dense is not None:
             set_(self, "dense", _frozen(self.dense, 2))
         self._check()
+        rows = tuple((self.A[i, :i].copy(), float(self.c[i])) for i in range(1, self.stages))
+        set_(self, "rows", rows)  # stage rows pre-sliced for the stepper's inner loop
 
     def _check(self) -> None:
         s = self.stages

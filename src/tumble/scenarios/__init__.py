@@ -1,0 +1,37 @@
+"""Built-in scenarios that reproduce the seeds, by name.
+
+Each scenario is a module with ``NAME``, ``SUMMARY`` and ``run(**options) -> ScenarioResult``
+(see :mod:`tumble.scenarios._base`). ``tumble run NAME`` runs one and writes its run folder.
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from types import ModuleType
+
+from tumble.scenarios._base import ScenarioResult
+
+_MODULES = {
+    "projectile": "tumble.scenarios.projectile",
+}
+
+
+def names() -> list[str]:
+    """The built-in scenarios' names, sorted."""
+    return sorted(_MODULES)
+
+
+def get(name: str) -> ModuleType:
+    """The scenario module called ``name``.
+
+    Raises
+    ------
+    ValueError
+        If there is no such scenario (the message lists the known ones).
+    """
+    if name not in _MODULES:
+        raise ValueError(f"scenario={name!r} is not known; choose one of {names()}")
+    return import_module(_MODULES[name])
+
+
+__all__ = ["ScenarioResult", "get", "names"]
