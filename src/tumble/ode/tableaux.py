@@ -173,14 +173,15 @@ FEHLBERG45 = ButcherTableau(
         [439 / 216, -8, 3680 / 513, -845 / 4104, 0, 0],
         [-8 / 27, 2, -3544 / 2565, 1859 / 4104, -11 / 40, 0],
     ],
-    b=[25 / 216, 0, 1408 / 2565, 2197 / 4104, -1 / 5, 0],
-    order=4,
-    b_hat=[16 / 135, 0, 6656 / 12825, 28561 / 56430, -9 / 50, 2 / 55],
-    order_hat=5,
+    b=[16 / 135, 0, 6656 / 12825, 28561 / 56430, -9 / 50, 2 / 55],
+    order=5,
+    b_hat=[25 / 216, 0, 1408 / 2565, 2197 / 4104, -1 / 5, 0],
+    order_hat=4,
     reference=(
         "Fehlberg, E. (1969). Low-order classical Runge-Kutta formulas with stepsize control "
-        "and their application to some heat transfer problems. NASA TR R-315. The fourth-order "
-        "solution is propagated, as Fehlberg did."
+        "and their application to some heat transfer problems. NASA TR R-315. The fifth-order "
+        "solution is propagated (local extrapolation, as GSL's rkf45 and every modern pair do); "
+        "the fourth-order one only measures the error."
     ),
 )
 
