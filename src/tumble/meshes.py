@@ -1,0 +1,315 @@
+"""Triangle meshes (trimesh) of the primitive solids, and mesh files in and out.
+
+Every generator returns a closed (watertight), consistently and outward-wound
+``trimesh.Trimesh`` whose vertices lie on the exact surface, so its mass properties
+(:func:`tumble.mass.from_mesh`) converge to the closed forms of :mod:`tumble.mass` as the
+section count grows, with error ∝ 1/sections². They replace the seeds' ``torus.stl`` and
+``Prism_hexagon.stl``, which are not available. ``axis`` and ``center`` mean what they mean
+in :mod:`tumble.mass`.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from os import PathLike
+from pathlib import Path
+
+import numpy as np
+import trimesh
+from numpy.typing import ArrayLike
+
+from tumble.mass import axis_vector, validate_point, validate_positive
+from tumble.so3 import validate_rotation
+
+DEFAULT_SECTIONS = 64
+"""Default number of sections around a circle (torus both ways, cylinder)."""
+LOAD_FORMATS = ("glb", "gltf", "obj", "off", "ply", "stl")
+"""File extensions :func:`load` accepts (trimesh's triangle-mesh readers)."""
+SAVE_FORMATS = ("glb", "obj", "off", "ply", "stl")
+"""File extensions :func:`save` writes (trimesh's mesh exporters)."""
+
+
+def _sections(value: int, name: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 3:
+        raise ValueError(f"{name} must be an integer >= 3; got {value!r}")
+    return int(value)
+
+
+def _placement(axis: str | ArrayLike, center: ArrayLike) -> np.ndarray:
+    """4×4 transform taking the mesh's local z axis to ``axis`` and its origin to ``center``."""
+    transform = trimesh.geometry.align_vectors([0.0, 0.0, 1.0], axis_vector(axis))
+    transform[:3, 3] = validate_point(center, name="center")
+    return transform
+
+
+def torus(
+    major_radius: float,
+    minor_radius: float,
+    sections: int = DEFAULT_SECTIONS,
+    *,
+    minor_sections: int | None = None,
+    axis: str | ArrayLike = "z",
+    center: ArrayLike = (0.0, 0.0, 0.0),
+) -> trimesh.Trimesh:
+    """Ring torus: ``sections`` around the axis, ``minor_sections`` around the tube.
+
+    Parameters
+    ----------
+    major_radius, minor_radius : float
+        ``R`` and ``r`` (m), ``0 < r < R``.
+    sections : int
+        Sections around the symmetry axis, >= 3.
+    minor_sections : int, optional
+        Sections around the tube; defaults to ``sections``.
+    axis, center
+        Symmetry axis and centre (m), as in :func:`tumble.mass.torus`.
+
+    Returns
+    -------
+    trimesh.Trimesh
+        ``2 · sections · minor_sections`` triangles.
+
+    Examples
+    --------
+    >>> round(float(torus(1.0, 0.5, 64).volume), 4)  # exact 2π²Rr² = 4.9348
+    4.919
+    """
+    R = validate_positive(major_radius, name="major_radius")
+    r = validate_positive(minor_radius, name="minor_radius")
+    if r >= R:
+        raise ValueError(
+            f"minor_radius must be less than major_radius ({R!r}) for a ring torus; "
+            f"got minor_radius={minor_radius!r}"
+        )
+    n = _sections(sections, "sections")
+    k = n if minor_sections is None else _sections(minor_sections, "minor_sections")
+    return trimesh.creation.torus(
+        R, r, major_sections=n, minor_sections=k, transform=_placement(axis, center)
+    )
+
+
+def cylinder(
+    radius: float,
+    length: float,
+    sections: int = DEFAULT_SECTIONS,
+    *,
+    axis: str | ArrayLike = "z",
+    center: ArrayLike = (0.0, 0.0, 0.0),
+) -> trimesh.Trimesh:
+    """Solid cylinder as a prism with ``sections`` sides inscribed in the circle.
+
+    Examples
+    --------
+    >>> mesh = cylinder(1.0, 2.0, 8, axis="x")
+    >>> mesh.is_watertight, mesh.extents.round(6).tolist()
+    (True, [2.0, 2.0, 2.0])
+    """
+    a = validate_positive(radius, name="radius")
+    L = validate_positive(length, name="length")
+    n = _sections(sections, "sections")
+    return trimesh.creation.cylinder(
+        radius=a, height=L, sections=n, transform=_placement(axis, center)
+    )
+
+
+def hex_prism(
+    circumradius: float,
+    length: float,
+    *,
+    axis: str | ArrayLike = "z",
+    center: ArrayLike = (0.0, 0.0, 0.0),
+) -> trimesh.Trimesh:
+    """Regular hexagonal prism (exact): a six-sided :func:`cylinder`, one vertex on local x.
+
+    Examples
+    --------
+    >>> bool(np.isclose(hex_prism(1.0, 1.0).volume, 1.5 * np.sqrt(3.0), rtol=1e-14))
+    True
+    """
+    return cylinder(circumradius, length, 6, axis=axis, center=center)
+
+
+def box(
+    extents: ArrayLike,
+    *,
+    rotation: ArrayLike | None = None,
+    center: ArrayLike = (0.0, 0.0, 0.0),
+) -> trimesh.Trimesh:
+    """Rectangular box (exact) of edge lengths ``extents`` (m), turned by ``rotation``.
+
+    Examples
+    --------
+    >>> round(float(box([1.0, 2.0, 3.0]).volume), 12)
+    6.0
+    """
+    sides = np.asarray(extents, dtype=float)
+    if sides.shape != (3,) or not np.all(np.isfinite(sides) & (sides > 0)):
+        raise ValueError(f"extents must be three finite lengths > 0 (m); got {extents!r}")
+    transform = np.eye(4)
+    if rotation is not None:
+        transform[:3, :3] = validate_rotation(rotation, name="rotation")
+    transform[:3, 3] = validate_point(center, name="center")
+    return trimesh.creation.box(extents=sides, transform=transform)
+
+
+def sphere(
+    radius: float, subdivisions: int = 4, *, center: ArrayLike = (0.0, 0.0, 0.0)
+) -> trimesh.Trimesh:
+    """Icosphere: an icosahedron subdivided ``subdivisions`` times (20·4^s triangles).
+
+    Examples
+    --------
+    >>> len(sphere(1.0, 2).faces)
+    320
+    """
+    a = validate_positive(radius, name="radius")
+    if isinstance(subdivisions, bool) or not isinstance(subdivisions, (int, np.integer)):
+        raise ValueError(f"subdivisions must be an integer >= 0; got {subdivisions!r}")
+    if subdivisions < 0:
+        raise ValueError(f"subdivisions must be an integer >= 0; got {subdivisions!r}")
+    mesh = trimesh.creation.icosphere(subdivisions=int(subdivisions), radius=a)
+    return mesh.apply_translation(validate_point(center, name="center"))
+
+
+def t_handle(sections: int = DEFAULT_SECTIONS) -> trimesh.Trimesh:
+    """Seed 002's T-handle (:func:`tumble.mass.t_handle` defaults) as two cylinder meshes.
+
+    The handle (R = 1 cm, L = 8 cm, axis y, centre x = −1 cm) and the shaft (R = 1 cm,
+    L = 4 cm, axis x, centre x = +2 cm) touch along a line at x = 0 without overlapping, so
+    the two closed parts are kept as one mesh of two bodies (no boolean union); its mass
+    properties are the sum of the parts'.
+
+    Examples
+    --------
+    >>> mesh = t_handle(16)
+    >>> mesh.is_watertight, mesh.body_count
+    (True, 2)
+    """
+    handle = cylinder(0.01, 0.08, sections, axis="y", center=(-0.01, 0.0, 0.0))
+    shaft = cylinder(0.01, 0.04, sections, axis="x", center=(0.02, 0.0, 0.0))
+    return trimesh.util.concatenate([handle, shaft])
+
+
+def validate_solid(mesh: object, *, name: str = "mesh") -> trimesh.Trimesh:
+    """Return ``mesh`` if it is a closed, consistently wound triangle mesh.
+
+    Closed means watertight (every edge shared by exactly two faces); consistent winding
+    means neighbouring faces agree on which side is out. Orientation (outward or inside-out,
+    the sign of ``mesh.volume``) is left to the caller.
+
+    Raises
+    ------
+    ValueError
+        Naming ``name``, what is wrong and a trimesh repair to try.
+
+    Examples
+    --------
+    >>> validate_solid(box([1.0, 1.0, 1.0])).is_watertight
+    True
+    """
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise ValueError(
+            f"{name} must be a trimesh.Trimesh with faces or a mesh file path; got {mesh!r}"
+        )
+    if not mesh.is_watertight:
+        raise ValueError(
+            f"{name} must be a closed (watertight) surface; got an open mesh {mesh!r}. "
+            "Repair it, e.g. trimesh.repair.fill_holes(mesh)."
+        )
+    if not mesh.is_winding_consistent:
+        raise ValueError(
+            f"{name} must have consistently wound faces; got {mesh!r}. Repair it, e.g. "
+            "trimesh.repair.fix_winding(mesh)."
+        )
+    return mesh
+
+
+def _suffix(path: Path, formats: tuple[str, ...], name: str) -> str:
+    suffix = path.suffix.lower().lstrip(".")
+    if suffix not in formats:
+        raise ValueError(
+            f"{name} must end in one of {', '.join('.' + f for f in formats)}; got {str(path)!r}"
+        )
+    return suffix
+
+
+def load(path: str | PathLike[str]) -> trimesh.Trimesh:
+    """Read a triangle mesh from a file (STL, OBJ, PLY, OFF, GLB, ... as trimesh reads).
+
+    Parameters
+    ----------
+    path : str or path-like
+
+    Returns
+    -------
+    trimesh.Trimesh
+        Duplicate vertices merged (trimesh's ``process=True``), so a closed STL is
+        watertight.
+
+    Raises
+    ------
+    ValueError
+        If the file does not exist, has an unknown extension, cannot be parsed, or holds no
+        triangles; the message names ``path`` and what is allowed.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = pathlib.Path(folder) / "box.stl"
+    ...     _ = save(box([1.0, 2.0, 3.0]), path)
+    ...     print(round(float(load(path).volume), 9))
+    6.0
+    """
+    file = Path(path)
+    if not file.is_file():
+        raise ValueError(f"path must be an existing mesh file; got {str(path)!r} (not found)")
+    file_type = _suffix(file, LOAD_FORMATS, "path")
+    try:
+        mesh = trimesh.load_mesh(file, file_type=file_type)
+    except Exception as error:  # trimesh raises many types for a bad file
+        raise ValueError(
+            f"path must be a readable {file_type} mesh file; could not read {str(path)!r}: {error}"
+        ) from error
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise ValueError(
+            f"path must be a mesh file with triangles; {str(path)!r} has none (empty or not "
+            f"a {file_type} file)"
+        )
+    return mesh
+
+
+def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
+    """Write ``mesh`` to ``path``; the format follows the extension (.stl, .obj, .ply, ...).
+
+    The file is written to a temporary name in the same folder and then renamed, so it
+    appears complete or not at all.
+
+    Returns
+    -------
+    pathlib.Path
+        The path written.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     print(save(box([1.0, 1.0, 1.0]), pathlib.Path(folder) / "cube.stl").name)
+    cube.stl
+    """
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise ValueError(f"mesh must be a trimesh.Trimesh with faces; got {mesh!r}")
+    file = Path(path)
+    file_type = _suffix(file, SAVE_FORMATS, "path")
+    if not file.parent.is_dir():
+        raise ValueError(f"path must be in an existing folder; got {str(path)!r}")
+    handle, temporary = tempfile.mkstemp(dir=file.parent, suffix=file.suffix)
+    os.close(handle)
+    try:
+        mesh.export(temporary, file_type=file_type)
+        os.replace(temporary, file)
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+    return file

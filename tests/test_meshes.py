@@ -1,0 +1,173 @@
+"""Tests for tumble.meshes: closed outward meshes, convergence, files in and out."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from tumble import mass, meshes
+
+# SPEC §4 closed forms for the torus R = 1, r = 0.5, rho = 1.
+TORUS_VOLUME = 2 * np.pi**2 * 1.0 * 0.5**2
+TORUS_INERTIA = TORUS_VOLUME * np.array([0.5 + 5 / 32, 0.5 + 5 / 32, 1.0 + 3 / 16])
+# Seed 000: its (unavailable) torus.stl gave these, printed to 3 decimals.
+SEED_VOLUME, SEED_INERTIA = 4.918, np.array([3.223, 3.223, 5.832])
+
+GENERATORS = {
+    "torus": lambda: meshes.torus(1.0, 0.5, 24, axis=[1.0, 1.0, 0.0], center=(1, 2, 3)),
+    "torus-thin": lambda: meshes.torus(2.0, 0.1, 12, minor_sections=5),
+    "cylinder": lambda: meshes.cylinder(0.5, 2.0, 16, axis="x"),
+    "cylinder-reversed-axis": lambda: meshes.cylinder(0.5, 2.0, 16, axis=[0.0, 0.0, -1.0]),
+    "hex_prism": lambda: meshes.hex_prism(0.3, 1.0, axis="y"),
+    "box": lambda: meshes.box([1.0, 2.0, 3.0], rotation=np.diag([1.0, -1.0, -1.0])),
+    "sphere": lambda: meshes.sphere(0.7, 2, center=(0.0, 0.0, -1.0)),
+    "t_handle": lambda: meshes.t_handle(16),
+}
+
+
+@pytest.mark.parametrize("name", GENERATORS)
+def test_generated_mesh_is_closed_and_outward(name):
+    mesh = GENERATORS[name]()
+    assert mesh.is_watertight
+    assert mesh.is_winding_consistent
+    assert mesh.volume > 0
+
+
+def test_torus_mesh_is_placed_on_its_axis():
+    mesh = meshes.torus(1.0, 0.5, 32, axis="x", center=(0.0, 5.0, 0.0))
+    body = mass.from_mesh(mesh, density=1.0)
+    assert np.allclose(body.com, [0.0, 5.0, 0.0], rtol=0, atol=1e-12)
+    assert np.argmax(body.inertia.diagonal()) == 0  # the largest moment is about x
+
+
+def test_hex_prism_mesh_has_circumradius_vertices():
+    mesh = meshes.hex_prism(0.3, 1.0)
+    assert np.allclose(np.hypot(mesh.vertices[:, 0], mesh.vertices[:, 1]).max(), 0.3)
+    assert len(mesh.vertices) == 14  # 12 corners and two cap centres
+
+
+def test_torus_mesh_converges_at_second_order():
+    sections = np.array([16, 32, 64, 128])
+    errors = []
+    for n in sections:
+        body = mass.from_mesh(meshes.torus(1.0, 0.5, int(n)), density=1.0)
+        relative = [body.mass / TORUS_VOLUME - 1, *(body.inertia.diagonal() / TORUS_INERTIA - 1)]
+        errors.append(np.abs(relative))
+    errors = np.array(errors)
+    slopes = [np.polyfit(np.log(sections), np.log(e), 1)[0] for e in errors.T]
+    assert np.allclose(slopes, -2.0, atol=0.2), f"log-log slopes {slopes}, expected -2"
+    # Finest mesh: (2π/128)²/6 = 4e-4 per polygon; measured 8.0e-4 (volume) to 1.3e-3.
+    assert errors[-1].max() < 1.5e-3
+
+
+def test_torus_mesh_with_64_sections_is_close_to_the_seed_mesh():
+    # The seed's torus.stl is unknown; 64 x 64 sections lands within 3e-4 of its printed
+    # values (4.9190 vs 4.918, 3.2222 vs 3.223, 5.8304 vs 5.832): the same size of error
+    # (0.3-0.5 % below exact) but not the same digits. See docs/mass-properties.md.
+    body = mass.from_mesh(meshes.torus(1.0, 0.5, 64), density=1.0)
+    assert body.mass == pytest.approx(SEED_VOLUME, rel=3e-4)
+    assert np.allclose(body.inertia.diagonal(), SEED_INERTIA, rtol=3e-4, atol=0)
+
+
+def test_torus_mesh_with_80_by_53_sections_prints_the_seed_values():
+    # Found by searching major x minor = 3..128 x 3..128 (docs/mass-properties.md); 64 x 64
+    # does not round to the seed's three decimals.
+    body = mass.from_mesh(meshes.torus(1.0, 0.5, 80, minor_sections=53), density=1.0)
+    printed = np.round([body.mass, *body.inertia.diagonal()], 3)
+    assert np.array_equal(printed, [SEED_VOLUME, *SEED_INERTIA])
+
+
+@pytest.mark.parametrize("suffix", [".stl", ".obj", ".ply", ".off", ".glb"])
+def test_save_then_load_keeps_the_mass_properties(tmp_path, suffix):
+    mesh = meshes.torus(1.0, 0.5, 12)
+    path = meshes.save(mesh, tmp_path / f"torus{suffix}")
+    loaded = meshes.load(path)
+    assert loaded.is_watertight
+    # STL stores float32 coordinates: 1e-7 relative.
+    assert loaded.volume == pytest.approx(mesh.volume, rel=1e-6)
+
+
+def test_save_writes_nothing_when_the_export_fails(tmp_path, monkeypatch):
+    def broken_export(self, file_obj, file_type=None, **kwargs):
+        with open(file_obj, "wb") as file:
+            file.write(b"solid half")
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(trimesh.Trimesh, "export", broken_export)
+    with pytest.raises(RuntimeError, match="disk full"):
+        meshes.save(meshes.box([1.0, 1.0, 1.0]), tmp_path / "cube.stl")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_save_refuses_an_unknown_extension(tmp_path):
+    with pytest.raises(ValueError, match=r"path must end in one of \.glb, .*\.stl; got .*\.dwg"):
+        meshes.save(meshes.box([1.0, 1.0, 1.0]), tmp_path / "cube.dwg")
+
+
+def test_save_refuses_a_missing_folder(tmp_path):
+    with pytest.raises(ValueError, match=r"path must be in an existing folder; got .*nowhere"):
+        meshes.save(meshes.box([1.0, 1.0, 1.0]), tmp_path / "nowhere" / "cube.stl")
+
+
+def test_load_refuses_a_missing_file(tmp_path):
+    with pytest.raises(ValueError, match=r"path must be an existing mesh file; got .*absent\.stl"):
+        meshes.load(tmp_path / "absent.stl")
+
+
+def test_load_refuses_an_unknown_extension(tmp_path):
+    path = tmp_path / "drawing.dwg"
+    path.write_text("x")
+    with pytest.raises(ValueError, match=r"path must end in one of .*\.stl; got .*drawing\.dwg"):
+        meshes.load(path)
+
+
+def test_load_refuses_a_file_without_triangles(tmp_path):
+    path = tmp_path / "garbage.stl"
+    path.write_bytes(b"\x00garbage")
+    with pytest.raises(ValueError, match=r"path must be a mesh file with triangles; .*garbage"):
+        meshes.load(path)
+
+
+def test_load_refuses_an_unparsable_file(tmp_path):
+    path = tmp_path / "broken.glb"
+    path.write_bytes(b"glTF this is not binary gltf")
+    with pytest.raises(ValueError, match=r"path must be a readable glb mesh file; .*broken"):
+        meshes.load(path)
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (lambda: meshes.torus(1.0, 1.5), r"minor_radius must be less than major_radius"),
+        (lambda: meshes.torus(-1.0, 0.5), r"major_radius must be .*> 0; got -1\.0"),
+        (lambda: meshes.torus(1.0, 0.5, 2), r"sections must be an integer >= 3; got 2"),
+        (lambda: meshes.torus(1.0, 0.5, minor_sections=2.5), r"minor_sections must be an int"),
+        (lambda: meshes.cylinder(0.0, 1.0), r"radius must be .*> 0; got 0\.0"),
+        (lambda: meshes.cylinder(1.0, 1.0, axis="q"), r'axis must be "x"'),
+        (lambda: meshes.hex_prism(1.0, -3.0), r"length must be .*> 0; got -3\.0"),
+        (lambda: meshes.box([1.0, 0.0, 1.0]), r"extents must be .*> 0"),
+        (lambda: meshes.box([1.0, 1.0, 1.0], rotation=np.ones((3, 3))), r"rotation must be"),
+        (lambda: meshes.sphere(1.0, -1), r"subdivisions must be an integer >= 0; got -1"),
+        (lambda: meshes.sphere(-1.0), r"radius must be .*> 0; got -1\.0"),
+    ],
+    ids=[
+        "torus-minor-above-major",
+        "torus-negative-major",
+        "torus-two-sections",
+        "torus-fractional-minor-sections",
+        "cylinder-zero-radius",
+        "cylinder-unknown-axis",
+        "hex-prism-negative-length",
+        "box-zero-extent",
+        "box-bad-rotation",
+        "sphere-negative-subdivisions",
+        "sphere-negative-radius",
+    ],
+)
+def test_mesh_generators_refuse_bad_input(build, message):
+    with pytest.raises(ValueError, match=message):
+        build()
+
+
+def test_save_refuses_a_non_mesh(tmp_path):
+    with pytest.raises(ValueError, match=r"mesh must be a trimesh.Trimesh with faces; got 'x'"):
+        meshes.save("x", tmp_path / "x.stl")
