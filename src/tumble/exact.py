@@ -1,0 +1,399 @@
+"""Exact reference solutions: projectile, isotropic sphere, torque-free body; order measurement.
+
+Conventions (SPEC §2): SI units; R maps body to world; ω_body = Rᵀ ω_world; inertia about the
+centre of mass in body axes; Euler's equations I ω̇ = (I ω) × ω; L = R I ω_body is constant.
+
+References
+----------
+.. [1] L. D. Landau, E. M. Lifshitz, Mechanics, 3rd ed., Pergamon 1976, §33, §35, §37.
+.. [2] E. Hairer, C. Lubich, G. Wanner, Geometric Numerical Integration, 2nd ed., Springer 2006,
+   §IV.1 and §VII.5 (the free rigid body; the test body diag(2, 1, 2/3)).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from tumble._elliptic import (
+    body_omega,
+    body_period,
+    body_rotation,
+    check_rotation,
+    principal_axes,
+    rodrigues,
+)
+
+__all__ = [
+    "Projectile",
+    "free_body",
+    "free_body_period",
+    "free_body_rotation",
+    "measure_order",
+    "observed_order",
+    "projectile",
+    "sphere",
+]
+
+
+@dataclass(frozen=True)
+class Projectile:
+    """Drag-free projectile launched from (x0, y0) at speed v0 (m/s), angle (rad), gravity g.
+
+    x(t) = x0 + v0 cos α t,  y(t) = y0 + v0 sin α t − g t²/2; the ground is y = 0. The
+    formulas continue past `flight_time` (below ground). Built and checked by `projectile`.
+    """
+
+    v0: float
+    angle: float
+    g: float = 9.81
+    x0: float = 0.0
+    y0: float = 0.0
+
+    def __post_init__(self) -> None:
+        _scalar("v0", self.v0, self.v0 >= 0, "a speed >= 0 in m/s")
+        _scalar("angle", self.angle, abs(self.angle) <= np.pi / 2, "radians in [-pi/2, pi/2]")
+        _scalar("g", self.g, self.g > 0, "an acceleration > 0 in m/s^2")
+        _scalar("x0", self.x0, True, "a finite position in m")
+        _scalar("y0", self.y0, self.y0 >= 0, "a height >= 0 in m (the ground is y = 0)")
+
+    @property
+    def flight_time(self) -> float:
+        """Time of impact with y = 0, s: (v0 sin α + √(v0² sin²α + 2 g y0)) / g."""
+        vy = self.v0 * np.sin(self.angle)
+        return float((vy + np.sqrt(vy * vy + 2.0 * self.g * self.y0)) / self.g)
+
+    @property
+    def range(self) -> float:
+        """Horizontal distance from launch to impact, m: v0 cos α · flight_time."""
+        return float(self.v0 * np.cos(self.angle) * self.flight_time)
+
+    @property
+    def max_height(self) -> float:
+        """Highest y reached, m: y0 + (v0 sin α)² / (2g) when launched upwards, else y0."""
+        vy = max(self.v0 * np.sin(self.angle), 0.0)
+        return float(self.y0 + vy * vy / (2.0 * self.g))
+
+    def position(self, t: ArrayLike) -> np.ndarray:
+        """(x, y) in m at times t (s); shape (2,) for scalar t, (n, 2) for t of shape (n,)."""
+        t, scalar = _times(t)
+        x = self.x0 + self.v0 * np.cos(self.angle) * t
+        y = self.y0 + self.v0 * np.sin(self.angle) * t - 0.5 * self.g * t * t
+        return _shaped(np.stack([x, y], axis=-1), scalar)
+
+    def velocity(self, t: ArrayLike) -> np.ndarray:
+        """(vx, vy) in m/s at times t (s); shape (2,) or (n, 2) like `position`."""
+        t, scalar = _times(t)
+        vx = np.full_like(t, self.v0 * np.cos(self.angle))
+        vy = self.v0 * np.sin(self.angle) - self.g * t
+        return _shaped(np.stack([vx, vy], axis=-1), scalar)
+
+
+def projectile(
+    v0: float, angle: float, g: float = 9.81, x0: float = 0.0, y0: float = 0.0
+) -> Projectile:
+    """Exact drag-free projectile launched at speed `v0` (m/s) and `angle` (radians).
+
+    Parameters
+    ----------
+    v0 : float
+        Launch speed, m/s, ≥ 0.
+    angle : float
+        Elevation above the horizontal in **radians**, in [−π/2, π/2] (launch towards +x).
+    g : float
+        Gravitational acceleration, m/s², > 0.
+    x0, y0 : float
+        Launch point, m; y0 ≥ 0 is the height above the ground y = 0.
+
+    Returns
+    -------
+    Projectile
+        With ``flight_time`` = (v0 sin α + √(v0² sin²α + 2 g y0))/g, ``range``, ``max_height``,
+        ``position(t)`` and ``velocity(t)``.
+
+    References
+    ----------
+    SPEC §4: v0 = 500 m/s at 45°, g = 9.81: impact at 72.080202 s, range 25484.1998 m.
+
+    Examples
+    --------
+    >>> shot = projectile(500.0, np.pi / 4)
+    >>> round(shot.flight_time, 6), round(shot.range, 4)
+    (72.080202, 25484.1998)
+    """
+    return Projectile(v0, angle, g, x0, y0)
+
+
+def sphere(t: ArrayLike, omega0: ArrayLike = (1.0, 0.0, 0.0)) -> np.ndarray:
+    """Attitude of a torque-free isotropic body (I = c Id) starting at R(0) = Id.
+
+    With I proportional to the identity ω is constant and R(t) = exp(t ω̃0): a rotation about
+    ω0 by the angle |ω0| t, by Rodrigues' formula
+    exp(θ k̃) = Id + sin θ k̃ + (1 − cos θ) k̃² with k = ω0/|ω0|, θ = |ω0| t.
+
+    Parameters
+    ----------
+    t : float or ndarray, shape (n,)
+        Times, s.
+    omega0 : array_like, shape (3,)
+        Angular velocity, rad/s (body and world frames agree up to R).
+
+    Returns
+    -------
+    ndarray, shape (3, 3) for scalar t, (n, 3, 3) otherwise
+        R(t), body to world.
+
+    References
+    ----------
+    Seed 002 (the sphere, I = Id, L = (1, 0, 0)); Hairer–Lubich–Wanner [2] §IV.1.
+
+    Examples
+    --------
+    >>> np.round(sphere(np.pi / 2), 12) + 0.0
+    array([[ 1.,  0.,  0.],
+           [ 0.,  0., -1.],
+           [ 0.,  1.,  0.]])
+    """
+    t, scalar = _times(t)
+    omega0 = _vector("omega0", omega0)
+    return _shaped(rodrigues(omega0, t), scalar)
+
+
+def free_body(inertia: ArrayLike, omega0: ArrayLike, t: ArrayLike) -> np.ndarray:
+    """Body angular velocity ω(t) of the torque-free rigid body, exactly.
+
+    Solves I ω̇ = (I ω) × ω, ω(0) = ω0. In the principal frame with A < B < C and the energy
+    2E = ω·Iω, the momentum |L|² = |Iω|² and Δ = |L|² − 2EB (Landau & Lifshitz §37):
+
+    * Δ > 0 (spin nearer the largest axis C): ω_A = a_A cn u, ω_B = σ a_B sn u,
+      ω_C = σ a_C dn u, with a_A² = (2EC − L²)/(A(C − A)), a_B² = (2EC − L²)/(B(C − B)),
+      a_C² = (L² − 2EA)/(C(C − A)), λ² = (C − B)(L² − 2EA)/(ABC),
+      m = (B − A)(2EC − L²)/((C − B)(L² − 2EA)).
+    * Δ < 0 (nearer the smallest axis A): the same with A and C exchanged,
+      ω_A = σ a_A dn u, ω_C = a_C cn u, a_B² = (L² − 2EA)/(B(B − A)).
+
+    Here u = u0 + λt, σ = sign of the dn component at t = 0, and u0 = F(am u0 | m) with
+    (cn u0, sn u0) read off ω0. A symmetric body (two equal moments, about axis e_s)
+    precesses: ω(t) = exp(−Ωt ẽ_s) ω0, Ω = (I⊥ − I_s) ω_s / I⊥. A sphere, or a spin about a
+    principal axis, keeps ω constant.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3,) or (3, 3)
+        Principal moments in body axes (any order), or a symmetric positive definite tensor
+        about the centre of mass, kg m². A full tensor is diagonalised, solved in its principal
+        axes and rotated back. The triangle inequality is not required (e.g. diag(2, 1, 2/3)).
+    omega0 : array_like, shape (3,)
+        Initial body angular velocity, rad/s.
+    t : float or ndarray, shape (n,)
+        Times, s.
+
+    Returns
+    -------
+    ndarray, shape (3,) for scalar t, (n, 3) otherwise
+        ω_body(t), rad/s.
+
+    Raises
+    ------
+    ValueError
+        On bad input, or ω0 on the separatrix |L|² = 2EB (relative tolerance 1e-12) and not
+        a steady spin: the motion takes infinite time to leave the middle axis (m = 1).
+
+    References
+    ----------
+    Landau & Lifshitz [1] §37; Hairer–Lubich–Wanner [2] §VII.5; Carlson forms: DLMF §19.25.
+
+    Examples
+    --------
+    >>> w = free_body([2.0, 1.0, 2.0 / 3.0], [0.2, 0.0, 1.3], [0.0, 1.0])
+    >>> w.shape, bool(np.allclose(w[0], [0.2, 0.0, 1.3]))
+    ((2, 3), True)
+    """
+    t, scalar = _times(t)
+    moments, axes = principal_axes(inertia)
+    return _shaped(body_omega(moments, axes, _vector("omega0", omega0), t), scalar)
+
+
+def free_body_period(inertia: ArrayLike, omega0: ArrayLike) -> float:
+    """Period of ω_body(t) of the torque-free body, s.
+
+    4K(m)/λ for an asymmetric body (m, λ as in `free_body`), 2π/|Ω| for a symmetric one. On
+    the separatrix it is ``inf`` (the motion never returns; no error, test ``math.isinf``).
+    Where ω is constant it is the limit of nearby periods: 2π/λ (small oscillations) for a
+    spin about the largest or smallest axis, ``inf`` for a spin about the middle axis, a
+    transverse spin of a symmetric body, a sphere or ω0 = 0.
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3,) or (3, 3)
+        As in `free_body`, kg m².
+    omega0 : array_like, shape (3,)
+        Initial body angular velocity, rad/s.
+
+    Returns
+    -------
+    float
+        The period, s (``inf`` as described).
+
+    References
+    ----------
+    Landau & Lifshitz [1] §37 (the period 4K/λ).
+
+    Examples
+    --------
+    >>> round(free_body_period([1.0, 1.0, 2.0], [0.3, 0.0, 1.0]), 12) == round(2 * np.pi, 12)
+    True
+    """
+    moments, axes = principal_axes(inertia)
+    return body_period(moments, axes, _vector("omega0", omega0))
+
+
+def free_body_rotation(
+    inertia: ArrayLike, omega0: ArrayLike, t: ArrayLike, R0: ArrayLike | None = None
+) -> np.ndarray:
+    """Attitude R(t) (body to world) of the torque-free body, exactly.
+
+    L = R0 I ω0 is constant. In the pole frame (q, r, p), p the axis the spin stays near,
+    R(t) = W Rz(φ) M(l) Pᵀ: l = Iω/|L|, M(l) = Rx(θ) Rz(ψ) the rotation with last row lᵀ
+    (Landau's Euler angles), P the pole axes in body coordinates, W = R0 P M(l(0))ᵀ, and
+    φ̇ = |L| (I_q ω_q² + I_r ω_r²)/(L_q² + L_r²) integrated in closed form,
+    φ = |L| t / I_p ± |L| (C − A)/(A C λ) [Π(−ν; am u | m)]₀ᵗ (docs/exact.md). A symmetric
+    body: R(t) = exp(t L̃/I⊥) R0 exp(Ωt ẽ_s); a constant ω: R(t) = R0 exp(t ω̃0).
+
+    Parameters
+    ----------
+    inertia : array_like, shape (3,) or (3, 3)
+        As in `free_body`, kg m².
+    omega0 : array_like, shape (3,)
+        Initial body angular velocity, rad/s.
+    t : float or ndarray, shape (n,)
+        Times, s.
+    R0 : array_like, shape (3, 3), optional
+        Initial attitude, a rotation matrix; identity by default.
+
+    Returns
+    -------
+    ndarray, shape (3, 3) for scalar t, (n, 3, 3) otherwise
+        R(t).
+
+    Raises
+    ------
+    ValueError
+        As `free_body` (bad input, separatrix), or R0 not a rotation.
+
+    References
+    ----------
+    Landau & Lifshitz [1] §35 (Euler angles), §37; Hairer–Lubich–Wanner [2] §VII.5;
+    Carlson forms of Π: DLMF 19.25.14.
+
+    Examples
+    --------
+    >>> R = free_body_rotation([2.0, 1.0, 2.0 / 3.0], [0.2, 0.0, 1.3], 5.0)
+    >>> bool(np.allclose(R.T @ R, np.eye(3)))
+    True
+    """
+    t, scalar = _times(t)
+    moments, axes = principal_axes(inertia)
+    omega0, R0 = _vector("omega0", omega0), check_rotation("R0", R0)
+    return _shaped(body_rotation(moments, axes, omega0, R0, t), scalar)
+
+
+def observed_order(step_sizes: ArrayLike, errors: ArrayLike) -> float:
+    """Observed order p of a method: the least-squares slope of log(error) against log(h).
+
+    Fits log e = p log h + c with ``np.polyfit``; e ∝ h^p gives exactly p.
+
+    Parameters
+    ----------
+    step_sizes : array_like, shape (k,)
+        At least two distinct positive step sizes.
+    errors : array_like, shape (k,)
+        The positive errors measured with them.
+
+    Returns
+    -------
+    float
+        The slope p.
+
+    Examples
+    --------
+    >>> round(observed_order([0.1, 0.05, 0.025], [1e-4, 6.25e-6, 3.90625e-7]), 12)
+    4.0
+    """
+    h = _positive_array("step_sizes", step_sizes)
+    e = _positive_array("errors", errors, remedy=" (an exact method has no observed order)")
+    if e.shape != h.shape:
+        raise ValueError(f"errors has {e.size} values but step_sizes has {h.size}; pass one each")
+    if np.unique(h).size < 2:
+        raise ValueError(f"step_sizes={_show(h)} must hold at least two distinct values")
+    return float(np.polyfit(np.log(h), np.log(e), 1)[0])
+
+
+def measure_order(
+    run: Callable[[float], float], step_sizes: Sequence[float] | np.ndarray
+) -> tuple[float, np.ndarray]:
+    """Run a method at each step size and fit its observed order.
+
+    Parameters
+    ----------
+    run : callable
+        ``run(h) -> error``: integrates with step h (s) and returns a positive error
+        (e.g. the distance to an exact reference at the final time).
+    step_sizes : sequence of float, shape (k,)
+        At least two distinct positive step sizes.
+
+    Returns
+    -------
+    order : float
+        `observed_order` of the errors.
+    errors : ndarray, shape (k,)
+        ``run(h)`` for each h.
+
+    Examples
+    --------
+    >>> order, errors = measure_order(lambda h: 3.0 * h**2, [0.1, 0.05, 0.025])
+    >>> round(order, 12)
+    2.0
+    """
+    h = _positive_array("step_sizes", step_sizes)
+    errors = np.array([float(run(float(step))) for step in h])
+    return observed_order(h, errors), errors
+
+
+def _times(t: ArrayLike) -> tuple[np.ndarray, bool]:
+    """Times as a 1-D float array, and whether a scalar was given."""
+    arr = np.asarray(t, dtype=float)
+    if arr.ndim > 1 or not np.all(np.isfinite(arr)):
+        raise ValueError(f"t={_show(arr)} must be a finite scalar or a 1-D array of times in s")
+    return arr.reshape(-1), arr.ndim == 0
+
+
+def _shaped(out: np.ndarray, scalar: bool) -> np.ndarray:
+    return out[0] if scalar else out
+
+
+def _vector(name: str, value: ArrayLike) -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name}={_show(arr)} must be 3 finite components in rad/s")
+    return arr
+
+
+def _positive_array(name: str, value: ArrayLike, remedy: str = "") -> np.ndarray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim != 1 or arr.size < 2 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
+        raise ValueError(f"{name}={_show(arr)} must be 1-D, >= 2 finite values > 0{remedy}")
+    return arr
+
+
+def _scalar(name: str, value: float, allowed: bool, what: str) -> None:
+    if not (np.isfinite(value) and allowed):
+        raise ValueError(f"{name}={value!r} is not allowed; pass {what}")
+
+
+def _show(arr: np.ndarray) -> str:
+    """An array for an error message, summarised when long."""
+    return np.array2string(arr, threshold=9, edgeitems=3)

@@ -1,0 +1,29 @@
+"""Rigid-body dynamics: the model, its loads, the methods and ``simulate``.
+
+=========================  ===================================================================
+:class:`RigidBody`         mass and inertia about the centre of mass (body axes)
+:func:`simulate`           one entry point for every method; returns a :class:`Trajectory`
+:class:`Gravity` …         loads: :class:`Force`, :class:`Torque`, :class:`Impulse`
+:data:`METHODS`            ``euler``, ``lie-euler``, ``rk4-matrix``, ``rk4-quat``,
+                           ``seed-rk4``, ``rkmk4``, ``rkmk45``
+=========================  ===================================================================
+"""
+
+from tumble.rigid.body import RigidBody
+from tumble.rigid.forces import Force, Gravity, Impulse, State, Torque
+from tumble.rigid.methods import METHODS, Method
+from tumble.rigid.simulate import simulate
+from tumble.rigid.trajectory import Trajectory
+
+__all__ = [
+    "METHODS",
+    "Force",
+    "Gravity",
+    "Impulse",
+    "Method",
+    "RigidBody",
+    "State",
+    "Torque",
+    "Trajectory",
+    "simulate",
+]

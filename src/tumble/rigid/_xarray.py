@@ -1,0 +1,46 @@
+"""Trajectory → xarray.Dataset (xarray imported only here)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+
+def trajectory_dataset(trajectory):
+    """Build the dataset: every array with its dimensions, units and the run's settings."""
+    import xarray as xr
+
+    import tumble
+
+    vec, mat = ("time", "axis"), ("time", "row", "col")
+    variables = {
+        "x": (vec, trajectory.x, "m", "centre of mass, world frame"),
+        "v": (vec, trajectory.v, "m/s", "velocity of the centre of mass, world frame"),
+        "R": (mat, trajectory.R, "1", "attitude, body to world"),
+        "q": (("time", "component"), trajectory.q, "1", "unit quaternion [w, x, y, z]"),
+        "omega_body": (vec, trajectory.omega_body, "rad/s", "angular velocity, body frame"),
+        "L_world": (vec, trajectory.L_world, "kg m2/s", "angular momentum, world frame"),
+        "energy": (("time",), trajectory.energy, "J", "kinetic energy"),
+        "orthogonality_error": (("time",), trajectory.orthogonality_error, "1", "|RᵀR − I|_F"),
+    }
+    data_vars = {
+        name: xr.Variable(dims, values, attrs={"units": units, "long_name": text})
+        for name, (dims, values, units, text) in variables.items()
+    }
+    settings = {k: v for k, v in trajectory.settings.items() if v is not None}
+    attrs = {
+        "method": trajectory.method,
+        "mass": trajectory.body.mass,
+        "inertia": np.asarray(trajectory.body.inertia).ravel(),
+        "settings": json.dumps(settings),
+        "status": trajectory.status,
+        "message": trajectory.message,
+        "tumble_version": tumble.__version__,
+    }
+    coords = {
+        "time": ("time", trajectory.t, {"units": "s"}),
+        "axis": ["x", "y", "z"],
+        "component": ["w", "x", "y", "z"],
+    }
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)

@@ -1,0 +1,86 @@
+"""Misuse of the rigid-body API: ValueErrors naming the argument and what is allowed."""
+
+import numpy as np
+import pytest
+
+from tumble.rigid import RigidBody, simulate
+
+BODY = RigidBody(1.0, [1.0, 2.0, 2.5])
+
+
+@pytest.mark.parametrize("mass", [0.0, -1.0, np.nan])
+def test_non_positive_mass_is_refused(mass):
+    with pytest.raises(ValueError, match="mass"):
+        RigidBody(mass, np.eye(3))
+
+
+def test_inertia_not_positive_definite_is_refused():
+    with pytest.raises(ValueError, match="inertia"):
+        RigidBody(1.0, [1.0, -1.0, 1.0])
+
+
+def test_non_symmetric_inertia_is_refused():
+    with pytest.raises(ValueError, match="inertia"):
+        RigidBody(1.0, [[1.0, 0.5, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+
+
+def test_triangle_inequality_violation_names_the_remedy():
+    with pytest.raises(ValueError, match="allow_unphysical"):
+        RigidBody(1.0, [2.0, 1.0, 2.0 / 3.0])
+
+
+def test_triangle_inequality_waived_on_request():
+    body = RigidBody(1.0, [2.0, 1.0, 2.0 / 3.0], allow_unphysical=True)
+    assert body.inertia[0, 0] == 2.0
+
+
+def test_r0_not_a_rotation_is_refused():
+    with pytest.raises(ValueError, match="R0"):
+        simulate(BODY, 1.0, h=0.1, R0=np.diag([1.0, 1.0, -1.0]))
+
+
+def test_zero_quaternion_is_refused():
+    with pytest.raises(ValueError, match="q0"):
+        simulate(BODY, 1.0, h=0.1, q0=[0, 0, 0, 0])
+
+
+@pytest.mark.parametrize("h", [0.0, -0.1, np.nan])
+def test_bad_step_is_refused(h):
+    with pytest.raises(ValueError, match="h="):
+        simulate(BODY, 1.0, h=h)
+
+
+def test_missing_step_for_fixed_method_is_refused():
+    with pytest.raises(ValueError, match="h=None"):
+        simulate(BODY, 1.0)
+
+
+def test_both_omega0_and_l0_are_refused():
+    with pytest.raises(ValueError, match="omega0.*L0"):
+        simulate(BODY, 1.0, h=0.1, omega0=(1, 0, 0), L0=(1, 0, 0))
+
+
+def test_unknown_method_lists_the_known_ones():
+    with pytest.raises(ValueError, match="method='rk5'.*rkmk4"):
+        simulate(BODY, 1.0, method="rk5", h=0.1)
+
+
+def test_t_end_before_t0_is_refused():
+    with pytest.raises(ValueError, match="t_end"):
+        simulate(BODY, -1.0, h=0.1)
+
+
+@pytest.mark.parametrize("rtol", [0.0, -1e-6])
+def test_non_positive_rtol_is_refused(rtol):
+    with pytest.raises(ValueError, match="rtol"):
+        simulate(BODY, 1.0, method="rkmk45", rtol=rtol)
+
+
+def test_tolerance_for_fixed_step_method_is_refused():
+    with pytest.raises(ValueError, match="rtol"):
+        simulate(BODY, 1.0, h=0.1, rtol=1e-6)
+
+
+def test_unknown_load_is_refused():
+    with pytest.raises(ValueError, match=r"forces\[0\]"):
+        simulate(BODY, 1.0, h=0.1, forces=[(0, 0, -9.81)])
