@@ -5,7 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-dev
 BENCH_STAMP := $(VENV)/.installed-bench
-DEMO ?= projectile
+DEMO ?= t-handle
 RUN_DIR ?= runs/$(DEMO)
 
 .PHONY: demo test bench lint format clean

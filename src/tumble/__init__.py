@@ -23,6 +23,8 @@ Modules
 ==================================  ==========================================================
 """
 
+import logging
+
 from tumble import exact, mass, meshes, so3
 from tumble.ode import ButcherTableau, OdeResult, solve
 from tumble.rigid import (
@@ -37,6 +39,9 @@ from tumble.rigid import (
 )
 
 __version__ = "0.1.0"
+
+# The library never prints: it logs, and stays silent unless the application configures logging.
+logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 __all__ = [
     "METHODS",

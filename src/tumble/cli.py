@@ -51,8 +51,10 @@ def run(
         raise _fail(str(error)) from None
     table = Table(title=f"{name}: {folder}", box=None, show_header=False)
     for key, value in result.summary.items():
-        table.add_row(key, json.dumps(value) if not isinstance(value, str) else value)
+        if isinstance(value, str | int | float | bool) or value is None:
+            table.add_row(key, value if isinstance(value, str) else json.dumps(value))
     console.print(table)
+    console.print(f"full summary: {folder / 'summary.json'}", highlight=False)
 
 
 def main() -> None:  # pragma: no cover - console-script entry

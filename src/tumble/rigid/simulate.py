@@ -335,7 +335,11 @@ def simulate(
     }
     run = _Run(spec, Dynamics(body, loads), t0, R, Y, int(record_every))
     loads_for_kernel = kernel_loads if use_kernel else None
-    t_events = _integrate(run, t_end, h, rtol, atol, impulses, events, loads_for_kernel, progress)
+    # A blow-up is detected and reported as status -1, not as numpy warnings on the way.
+    with np.errstate(over="ignore", invalid="ignore"):
+        t_events = _integrate(
+            run, t_end, h, rtol, atol, impulses, events, loads_for_kernel, progress
+        )
     if run.status == -1:
         log.warning("simulate stopped early: %s", run.message)
     return run.trajectory(body, settings, t_events)

@@ -76,21 +76,24 @@ class Trajectory:
     @cached_property
     def omega_body(self) -> np.ndarray:
         """Body-frame angular velocity ``ω = I⁻¹ Rᵀ L``, shape (n, 3), rad/s."""
-        body_L = np.einsum("nji,nj->ni", self.R, self.L_world)
-        return body_L @ self.body.inertia_inverse.T
+        with np.errstate(over="ignore", invalid="ignore"):
+            body_L = np.einsum("nji,nj->ni", self.R, self.L_world)
+            return body_L @ self.body.inertia_inverse.T
 
     @cached_property
     def energy(self) -> np.ndarray:
         """Kinetic energy ``½ m |v|² + ½ ω·(Rᵀ L)``, shape (n,), J."""
-        body_L = np.einsum("nji,nj->ni", self.R, self.L_world)
-        rotational = 0.5 * np.einsum("ni,ni->n", self.omega_body, body_L)
-        return 0.5 * self.body.mass * np.einsum("ni,ni->n", self.v, self.v) + rotational
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverged run: inf, no warning
+            body_L = np.einsum("nji,nj->ni", self.R, self.L_world)
+            rotational = 0.5 * np.einsum("ni,ni->n", self.omega_body, body_L)
+            return 0.5 * self.body.mass * np.einsum("ni,ni->n", self.v, self.v) + rotational
 
     @cached_property
     def orthogonality_error(self) -> np.ndarray:
         """``‖RᵀR − I‖_F`` at each sample, shape (n,)."""
-        defect = np.einsum("nki,nkj->nij", self.R, self.R) - np.eye(3)
-        return np.linalg.norm(defect, axis=(1, 2))
+        with np.errstate(over="ignore", invalid="ignore"):
+            defect = np.einsum("nki,nkj->nij", self.R, self.R) - np.eye(3)
+            return np.linalg.norm(defect, axis=(1, 2))
 
     @cached_property
     def quaternion_norm_error(self) -> np.ndarray:

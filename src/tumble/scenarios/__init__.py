@@ -13,6 +13,11 @@ from tumble.scenarios._base import ScenarioResult
 
 _MODULES = {
     "projectile": "tumble.scenarios.projectile",
+    "torus-spin": "tumble.scenarios.torus_spin",
+    "prism-impulse": "tumble.scenarios.prism_impulse",
+    "sphere-exact": "tumble.scenarios.sphere_exact",
+    "t-handle": "tumble.scenarios.t_handle",
+    "convergence": "tumble.scenarios.convergence",
 }
 
 

@@ -1,0 +1,249 @@
+"""Seed 002, tasks 5–6: the T-handle spun about each principal axis; the middle one flips.
+
+The T-handle of :func:`tumble.mass.t_handle` has the principal moments
+diag(9.82271303e-05, 7.22671030e-05, 1.57865031e-04) kg m², so x is the *intermediate* axis,
+y the smallest and z the largest. Seed 002 spun it from ω(0) = (1, 0.05, 0), (0, 1, 0.05) and
+(0.05, 0, 1) rad/s for 100 s at h = 0.01 and plotted the nine entries of R(t) and the ZYX
+Euler angles. The spin about x is unstable: ω_x reverses again and again (the tennis-racket or
+Dzhanibekov effect), while the spins about y and z only wobble.
+
+Both motions are periodic in the body frame, with the period ``4K(m)/λ`` of the Jacobi
+elliptic solution (:func:`tumble.exact.free_body_period`). This scenario measures it from the
+simulation: two components of ω_body change sign, and every other zero crossing of one of them
+(crossings in the same direction) is one period apart. The handle flips twice per period.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from functools import partial
+
+import numpy as np
+
+from tumble import exact, mass
+from tumble.rigid import RigidBody, Trajectory, simulate
+from tumble.scenarios._base import ScenarioResult
+from tumble.viz import rigid
+
+NAME = "t-handle"
+SUMMARY = (
+    "Seed 002 tasks 5–6: the T-handle's three spins; the middle axis flips (measured period)."
+)
+
+SPINS = ((1.0, 0.05, 0.0), (0.0, 1.0, 0.05), (0.05, 0.0, 1.0))
+"""Seed 002's initial body angular velocities (rad/s)."""
+_AXES = "xyz"
+_ROLES = ("smallest (stable)", "intermediate (unstable)", "largest (stable)")
+
+
+def zero_crossings(t: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """Times at which ``values`` changes sign, by linear interpolation between samples.
+
+    A zero counts as positive, so the crossings alternate in direction.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Times (s).
+    values : ndarray, shape (n,)
+        Samples of a function of time.
+
+    Returns
+    -------
+    ndarray, shape (k,)
+        The crossing times (s), increasing.
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 10.0, 1001)
+    >>> np.round(zero_crossings(t, np.cos(t)), 4)
+    array([1.5708, 4.7124, 7.854 ])
+    """
+    positive = values >= 0
+    k = np.nonzero(positive[:-1] != positive[1:])[0]
+    return t[k] - values[k] * (t[k + 1] - t[k]) / (values[k + 1] - values[k])
+
+
+def measured_period(t: np.ndarray, omega: np.ndarray) -> tuple[float | None, int, np.ndarray]:
+    """The period of ω_body(t) from the zero crossings of its most-crossing component.
+
+    Every other crossing is in the same direction, one period later; the period is the mean
+    of ``c[k + 2] − c[k]``.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Times (s).
+    omega : ndarray, shape (n, 3)
+        Body angular velocity (rad/s).
+
+    Returns
+    -------
+    period : float or None
+        The period (s), or None when fewer than three crossings were seen (run longer).
+    component : int
+        Which component (0, 1, 2 for x, y, z) it was measured from.
+    crossings : ndarray
+        Its crossing times (s).
+    """
+    crossings = [zero_crossings(t, omega[:, k]) for k in range(3)]
+    component = int(np.argmax([len(c) for c in crossings]))
+    chosen = crossings[component]
+    if len(chosen) < 3:
+        return None, component, chosen
+    return float(np.mean(chosen[2:] - chosen[:-2])), component, chosen
+
+
+def _simulate(body, omega0, method, h, t_end, rtol) -> Trajectory:
+    if rtol is not None:
+        return simulate(body, t_end, method=method, h=h, rtol=rtol, omega0=omega0)
+    return simulate(body, t_end, method=method, h=h, omega0=omega0)
+
+
+def run(
+    *,
+    method: str = "rkmk4",
+    h: float | None = 0.01,
+    t_end: float = 100.0,
+    spins: Sequence[Sequence[float]] = SPINS,
+    rtol: float | None = None,
+) -> ScenarioResult:
+    """Spin the T-handle from each initial ω and compare the period with the closed form.
+
+    Parameters
+    ----------
+    method : str
+        A :data:`tumble.rigid.METHODS` name.
+    h : float or None
+        Step (s); the first step (or None) for ``rkmk45``.
+    t_end : float
+        End time (s). A period is measured once a component has crossed zero three times:
+        about one period (47 s for the unstable spin, 17 s and 7.4 s for the others).
+    spins : sequence of array_like, shape (3,)
+        Initial body angular velocities (rad/s).
+    rtol : float, optional
+        Tolerance for ``rkmk45``.
+
+    Returns
+    -------
+    ScenarioResult
+        ``summary["spins"]``: per spin ``omega0``, ``axis`` and ``axis_role``,
+        ``period_closed_form`` and ``period_measured`` (s; None if the run saw fewer than
+        three crossings), ``period_relative_difference``, ``measured_from``,
+        ``max_orthogonality_error``, ``energy_drift`` (largest ``|E/E₀ − 1|``),
+        ``momentum_drift`` (largest ``|L − L₀|/|L₀|``) and ``error_vs_exact``
+        (``‖R − R_exact‖_F`` at the end). Figures: ``rotation_grid_spin<k>.png``,
+        ``euler_angles_spin<k>.png`` for k = 1, 2, …, ``angular_velocity.png``, ``drift.png``.
+
+    Examples
+    --------
+    >>> result = run(t_end=20.0, spins=[(0.05, 0.0, 1.0)])
+    >>> spin = result.summary["spins"][0]
+    >>> abs(spin["period_measured"] / spin["period_closed_form"] - 1) < 1e-6
+    True
+    """
+    spins = [np.asarray(spin, dtype=float) for spin in spins]
+    if not spins:
+        raise ValueError("spins=() is not allowed: give at least one initial ω (rad/s)")
+    body = RigidBody.from_mass_properties(mass.t_handle())
+    runs = [_simulate(body, spin, method, h, t_end, rtol) for spin in spins]
+    results = [
+        _spin_result(body, spin, trajectory) for spin, trajectory in zip(spins, runs, strict=True)
+    ]
+    summary = {
+        "scenario": NAME,
+        "method": method,
+        "h": h,
+        "t_end": t_end,
+        "inertia": np.diag(body.inertia).tolist(),
+        "spins": [result for result, _ in results],
+    }
+    crossings = [marks for _, marks in results]
+    return ScenarioResult(
+        name=NAME,
+        summary=summary,
+        data={"trajectories": runs, "body": body, "crossings": crossings},
+        figures=_figures(summary, runs, crossings),
+    )
+
+
+def _role(inertia: np.ndarray, omega0: np.ndarray) -> tuple[str, str]:
+    """The principal axis the spin is nearest, and whether it is the smallest/middle/largest."""
+    axis = int(np.argmax(np.abs(omega0)))
+    rank = int(np.argsort(np.argsort(np.diag(inertia)))[axis])
+    return _AXES[axis], _ROLES[rank]
+
+
+def _spin_result(body: RigidBody, omega0: np.ndarray, run: Trajectory) -> tuple[dict, np.ndarray]:
+    closed_form = exact.free_body_period(body.inertia, omega0)
+    period, component, crossings = measured_period(run.t, run.omega_body)
+    axis, role = _role(body.inertia, omega0)
+    L0 = run.L_world[0]
+    with np.errstate(all="ignore"):
+        energy_drift = np.max(np.abs(run.energy / run.energy[0] - 1.0))
+        momentum = np.max(np.linalg.norm(run.L_world - L0, axis=1)) / np.linalg.norm(L0)
+    R_exact = exact.free_body_rotation(body.inertia, omega0, run.t[-1])
+    result = {
+        "omega0": omega0.tolist(),
+        "axis": axis,
+        "axis_role": role,
+        "period_closed_form": closed_form,
+        "period_measured": period,
+        "period_relative_difference": None if period is None else period / closed_form - 1,
+        "measured_from": f"omega_{_AXES[component]}",
+        "max_orthogonality_error": float(np.max(run.orthogonality_error)),
+        "energy_drift": float(energy_drift),
+        "momentum_drift": float(momentum),
+        "error_vs_exact": float(np.linalg.norm(run.R[-1] - R_exact)),
+    }
+    return result, crossings
+
+
+def _label(spin: dict) -> str:
+    omega = ", ".join(f"{w:g}" for w in spin["omega0"])
+    return f"ω₀ = ({omega}) rad/s, about {spin['axis']}: {spin['axis_role']}"
+
+
+def _period_note(spin: dict) -> str:
+    measured = spin["period_measured"]
+    shown = "not measured (run longer)" if measured is None else f"{measured:.4f} s"
+    closed = spin["period_closed_form"]
+    return f"period from {spin['measured_from']}: {shown} (closed form {closed:.4f} s)"
+
+
+def _figures(summary: dict, runs: list[Trajectory], crossings: list) -> list:
+    method, h = summary["method"], summary["h"]
+    setting = f"{method}, h = {h} s" if h is not None else method
+    labels = [_label(spin) for spin in summary["spins"]]
+    figures = []
+    for k, (label, run) in enumerate(zip(labels, runs, strict=True), start=1):
+        title = f"{NAME} — {label}\n{setting}"
+        grid = [(method, run.t, run.R)]
+        angles = [(method, run.t, run.euler_zyx())]
+        figures.append(
+            (f"rotation_grid_spin{k}.png", partial(rigid.rotation_grid, grid, title=title))
+        )
+        figures.append(
+            (f"euler_angles_spin{k}.png", partial(rigid.euler_angles, angles, title=title))
+        )
+    rates = [
+        (f"{label}; {_period_note(spin)}", run.t, run.omega_body)
+        for label, spin, run in zip(labels, summary["spins"], runs, strict=True)
+    ]
+    figures.append(
+        (
+            "angular_velocity.png",
+            partial(
+                rigid.angular_velocity,
+                rates,
+                title=f"{NAME} — body angular velocity ({setting}); dotted: zero crossings",
+                marks=crossings,
+            ),
+        )
+    )
+    drifts = [
+        (f"spin {k}: about {spin['axis']}", run)
+        for k, (spin, run) in enumerate(zip(summary["spins"], runs, strict=True), start=1)
+    ]
+    figures.append(("drift.png", partial(rigid.drift, drifts, title=f"{NAME} — {setting}")))
+    return figures

@@ -1,0 +1,93 @@
+"""Seed 002 tasks 5–6: the T-handle's three spins and the period of the intermediate-axis flip."""
+
+import json
+
+import numpy as np
+import pytest
+
+from tumble import scenarios
+from tumble.io import write_run_folder
+from tumble.scenarios.t_handle import measured_period, zero_crossings
+
+
+@pytest.fixture(scope="module")
+def result():
+    # 65 s at h = 0.02: the unstable spin (period 47.26 s) crosses zero three times
+    # (11.8, 35.4, 59.1 s), enough for one measured period; the stable ones many more.
+    return scenarios.get("t-handle").run(t_end=65.0, h=0.02)
+
+
+def test_seed_inertia_is_used(result):
+    np.testing.assert_allclose(
+        result.summary["inertia"], [9.82271303e-05, 7.22671030e-05, 1.57865031e-04], rtol=1e-8
+    )
+
+
+def test_the_spin_about_x_is_the_unstable_middle_axis(result):
+    roles = [spin["axis_role"] for spin in result.summary["spins"]]
+    assert roles == ["intermediate (unstable)", "smallest (stable)", "largest (stable)"]
+
+
+def test_the_intermediate_spin_flips(result):
+    omega_x = result.data["trajectories"][0].omega_body[:, 0]
+    assert omega_x.max() > 0.99 and omega_x.min() < -0.99
+
+
+@pytest.mark.parametrize("index", [0, 1, 2])
+def test_measured_period_matches_the_closed_form(result, index):
+    spin = result.summary["spins"][index]
+    # 1e-3 relative on this short, coarse run (measured ~1e-9); tests/rigid checks 1e-6.
+    assert spin["period_measured"] == pytest.approx(spin["period_closed_form"], rel=1e-3)
+
+
+def test_closed_form_periods(result):
+    periods = [spin["period_closed_form"] for spin in result.summary["spins"]]
+    np.testing.assert_allclose(periods, [47.2614505, 16.6503765, 7.4083571], rtol=1e-7)
+
+
+def test_rkmk4_keeps_so3_energy_and_momentum(result):
+    for spin in result.summary["spins"]:
+        assert spin["max_orthogonality_error"] < 1e-12
+        assert spin["energy_drift"] < 1e-8  # measured ≤ 1.4e-10 at h = 0.02
+        assert spin["momentum_drift"] == 0.0
+
+
+def test_zero_crossings_of_a_cosine_are_odd_multiples_of_half_pi():
+    t = np.linspace(0.0, 10.0, 2001)
+    np.testing.assert_allclose(
+        zero_crossings(t, np.cos(t)), [np.pi / 2, 1.5 * np.pi, 2.5 * np.pi], atol=1e-5
+    )
+
+
+def test_too_short_a_run_measures_no_period():
+    t = np.linspace(0.0, 3.0, 301)
+    omega = np.stack([np.cos(t), np.sin(t), np.ones_like(t)], axis=1)
+    period, _, crossings = measured_period(t, omega)
+    assert period is None and len(crossings) == 1
+
+
+def test_summary_is_json_with_the_promised_keys(result):
+    summary = json.loads(json.dumps(result.summary))
+    assert summary["scenario"] == "t-handle"
+    assert summary["method"] == "rkmk4" and summary["h"] == 0.02
+    assert [spin["omega0"] for spin in summary["spins"]] == [
+        [1.0, 0.05, 0.0],
+        [0.0, 1.0, 0.05],
+        [0.05, 0.0, 1.0],
+    ]
+
+
+def test_run_folder_has_summary_and_every_figure(result, tmp_path):
+    folder = write_run_folder(result, tmp_path / "run")
+    assert json.loads((folder / "summary.json").read_text())["t_end"] == 65.0
+    names = {name for name, _ in result.figures}
+    expected = {f"rotation_grid_spin{k}.png" for k in (1, 2, 3)}
+    expected |= {f"euler_angles_spin{k}.png" for k in (1, 2, 3)}
+    assert names == expected | {"angular_velocity.png", "drift.png"}
+    for name in names:
+        assert (folder / name).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_no_spins_is_refused_by_name():
+    with pytest.raises(ValueError, match="spins="):
+        scenarios.get("t-handle").run(spins=())
