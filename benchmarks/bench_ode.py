@@ -44,8 +44,9 @@ def _row(name, tumble_case, scipy_case, error, repeat):
     )
 
 
-def main(quick: bool = False) -> None:
-    repeat = 3 if quick else 9
+def main(argv: list[str] | None = None) -> None:
+    argv = sys.argv[1:] if argv is None else argv
+    repeat = 3 if "--quick" in argv else 9
     v = 500 / np.sqrt(2)
     exact_range = 2 * v * v / 9.81
     reference = solve_ivp(van_der_pol, (0, 10), [2, 0], method="DOP853", rtol=1e-13, atol=1e-13)
@@ -90,4 +91,4 @@ def main(quick: bool = False) -> None:
 
 
 if __name__ == "__main__":
-    main(quick="--quick" in sys.argv)
+    main()

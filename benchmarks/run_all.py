@@ -8,14 +8,13 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-BENCHMARKS = ["bench_ode"]
+BENCHMARKS = ["bench_ode", "bench_structural"]
 
 
 def main() -> None:
-    quick = "--quick" in sys.argv
     for name in BENCHMARKS:
         module = importlib.import_module(name)
-        module.main(quick=quick)
+        module.main(sys.argv[1:])
         print()
 
 

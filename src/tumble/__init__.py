@@ -25,7 +25,7 @@ Modules
 
 import logging
 
-from tumble import exact, mass, meshes, so3
+from tumble import exact, mass, meshes, so3, structural
 from tumble.ode import ButcherTableau, OdeResult, solve
 from tumble.rigid import (
     METHODS,
@@ -59,4 +59,5 @@ __all__ = [
     "simulate",
     "so3",
     "solve",
+    "structural",
 ]

@@ -18,6 +18,7 @@ _MODULES = {
     "sphere-exact": "tumble.scenarios.sphere_exact",
     "t-handle": "tumble.scenarios.t_handle",
     "convergence": "tumble.scenarios.convergence",
+    "beam": "tumble.scenarios.beam",
 }
 
 

@@ -1,0 +1,200 @@
+"""Seed 003: a steel cantilever under a step tip load, stepped by the seed's four schemes.
+
+The 1 m cantilever with a 1 cm square steel section (E = 210 GPa, ρ = 7850 kg/m³) is
+clamped at x = 0 and loaded at the tip by a constant force from t = 0, starting at rest.
+The run computes its first four natural frequencies against the exact roots of
+``cos βL cosh βL = −1``, steps the ``explicit``, ``semi-implicit``, ``implicit`` and
+``midpoint`` schemes with one time step (``T₁/200`` by default, far above the
+semi-implicit limit ``2/ω_max``), sweeps the time step across that limit, and keeps the
+beam every 10 steps of the midpoint run as frames for an animation.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from tumble import structural
+from tumble.scenarios._base import ScenarioResult
+from tumble.structural import validation
+from tumble.viz import structural as viz
+
+NAME = "beam"
+SUMMARY = "Seed 003: steel cantilever under a step tip load, four time-stepping schemes"
+
+BETA_L = np.array([1.87510406871196, 4.69409113297418, 7.85475743823761, 10.9955407348755])
+"""The first roots of ``cos βL cosh βL = −1`` (clamped–free beam)."""
+
+SWEEP_FACTORS = (0.25, 0.5, 0.9, 0.98, 1.02, 1.1, 2.0, 10.0, 100.0)
+"""Sweep time steps, as multiples of the semi-implicit critical step."""
+
+
+def run(
+    *,
+    length: float = 1.0,
+    n_elements: int = 20,
+    E: float = 210e9,
+    rho: float = 7850.0,
+    width: float = 0.01,
+    height: float = 0.01,
+    tip_load: float = 1.0,
+    steps_per_period: int = 200,
+    n_steps: int = 2000,
+    sweep_steps: int = 1000,
+    frame_every: int = 10,
+) -> ScenarioResult:
+    """Compute the scenario; pure (no files, no printing).
+
+    Parameters
+    ----------
+    length, n_elements, E, rho, width, height, tip_load
+        The cantilever (:func:`tumble.structural.cantilever`): [m], –, [Pa], [kg/m³],
+        [m], [m], [N].
+    steps_per_period : int
+        Δt = T₁ / steps_per_period for the four scheme runs.
+    n_steps : int
+        Steps of each scheme run.
+    sweep_steps : int
+        Steps of each run in the stability sweep.
+    frame_every : int
+        Keep the midpoint beam every this many steps.
+
+    Returns
+    -------
+    ScenarioResult
+        ``summary``: frequencies and errors, Δt, the critical step, per-scheme energy
+        and tip results, the sweep; ``data``: the system, the runs, the sweeps and the
+        frames; ``figures``: energy per scheme, the sweep, the beam shapes.
+    """
+    for name, value in (
+        ("steps_per_period", steps_per_period),
+        ("n_steps", n_steps),
+        ("sweep_steps", sweep_steps),
+        ("frame_every", frame_every),
+    ):
+        validation.count(name, value)
+    beam = structural.cantilever(length, n_elements, E, rho, width, height, tip_load)
+    omega = beam.natural_frequencies(4)
+    dt = 2 * np.pi / omega[0] / steps_per_period
+    runs = {s: structural.integrate(beam, s, dt, n_steps=n_steps) for s in structural.SEED_SCHEMES}
+    critical = structural.critical_dt(beam, "semi-implicit")
+    dts = np.sort(np.r_[critical.dt * np.array(SWEEP_FACTORS), dt])
+    sweeps = [
+        structural.stability_sweep(beam, s, dts, sweep_steps) for s in structural.SEED_SCHEMES
+    ]
+    midpoint = runs["midpoint"]
+    frames = {
+        "t": midpoint.t[::frame_every],
+        "x": beam.expand(midpoint.x[::frame_every]),
+        "every": frame_every,
+        "scheme": "midpoint",
+        "nodes": beam.nodes,
+    }
+    settings = {
+        "length": length, "n_elements": n_elements, "E": E, "rho": rho, "width": width,
+        "height": height, "tip_load": tip_load, "steps_per_period": steps_per_period,
+        "n_steps": n_steps, "sweep_steps": sweep_steps, "frame_every": frame_every,
+    }  # fmt: skip
+    scale = structural.energy_scale(beam)
+    return ScenarioResult(
+        NAME,
+        _summary(settings, beam, omega, dt, critical, runs, sweeps, scale),
+        data={"system": beam, "runs": runs, "sweeps": sweeps, "frames": frames},
+        figures=_figures(beam, runs, sweeps, scale, frame_every),
+    )
+
+
+def exact_frequencies(
+    length: float, E: float, rho: float, width: float, height: float
+) -> np.ndarray:
+    """``ω_k = (β_k L)² sqrt(EI/(ρ A L⁴))`` [rad/s] of the first four clamped–free modes."""
+    EI, rho_A = E * width * height**3 / 12, rho * width * height
+    return BETA_L**2 * np.sqrt(EI / (rho_A * length**4))
+
+
+def _summary(settings, beam, omega, dt, critical, runs, sweeps, scale) -> dict[str, Any]:
+    """Headline numbers, JSON-serialisable (inf and NaN become None)."""
+    keys = ("length", "E", "rho", "width", "height")
+    exact = exact_frequencies(*(settings[k] for k in keys))
+    EI = settings["E"] * settings["width"] * settings["height"] ** 3 / 12
+    static_tip = settings["tip_load"] * settings["length"] ** 3 / (3 * EI)
+    per_scheme = {
+        scheme: _scheme_summary(response, scale, static_tip) for scheme, response in runs.items()
+    }
+    return {
+        **settings,
+        "n_dofs": beam.n_dofs,
+        "omega": omega.tolist(),
+        "omega_exact": exact.tolist(),
+        "omega_relative_error": (omega / exact - 1).tolist(),
+        "dt": dt,
+        "critical_dt_semi_implicit": critical.dt,
+        "critical_mode": critical.mode,
+        "omega_max": critical.omega,
+        "static_tip_deflection": static_tip,
+        "energy_scale": scale,
+        "schemes": per_scheme,
+        "sweep": {
+            sweep.scheme: {
+                "dt": sweep.dt.tolist(),
+                "energy_growth": [_number(g) for g in sweep.energy_growth],
+                "stable": sweep.stable.tolist(),
+            }
+            for sweep in sweeps
+        },
+    }
+
+
+def _scheme_summary(response, scale: float, static_tip: float) -> dict[str, Any]:
+    """Energy and tip numbers of one run, relative to the energy scale and static tip."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        change = (response.energy - response.energy[0]) / scale
+    tip = response.tip_displacement / static_tip
+    return {
+        "status": response.status,
+        "message": response.message,
+        "energy_change_max": _number(np.max(np.abs(change))),
+        "energy_change_final": _number(change[-1]),
+        "tip_mean_over_static": _number(tip.mean()) if response.success else None,
+        "tip_max_over_static": _number(tip.max()) if response.success else None,
+    }
+
+
+def _figures(beam, runs, sweeps, scale, every) -> list:
+    figures = [
+        (
+            f"energy_{scheme}.png",
+            viz.figure_writer(
+                viz.energy_figure, response, scale=scale, title=f"{NAME} — {scheme}: total energy"
+            ),
+        )
+        for scheme, response in runs.items()
+    ]
+    figures.append(
+        (
+            "stability_sweep.png",
+            viz.figure_writer(viz.stability_figure, sweeps, title=f"{NAME} — stability sweep"),
+        )
+    )
+    midpoint = runs["midpoint"]
+    period = slice(0, min(len(midpoint.t), 10 * every + 1))  # the first ten frames
+    figures.append(
+        (
+            "beam_shapes.png",
+            viz.figure_writer(
+                viz.beam_figure,
+                beam,
+                midpoint.t[period],
+                midpoint.x[period],
+                every=every,
+                title=f"{NAME} — midpoint, every {every} steps",
+            ),
+        )
+    )
+    return figures
+
+
+def _number(value: float) -> float | None:
+    """JSON has no inf or NaN: those become None."""
+    return float(value) if np.isfinite(value) else None
