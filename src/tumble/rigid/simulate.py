@@ -101,7 +101,7 @@ class _Run:
         )
 
 
-def _flat(run: _Run, R, Y) -> np.ndarray:
+def _flat(R, Y) -> np.ndarray:
     return np.concatenate([R.ravel(), Y])
 
 
@@ -119,18 +119,18 @@ class _Events:
 
     def __init__(self, events, run: _Run):
         wrapped = [_wrap_event(event) for event in events]
-        self.tracker = EventTracker(wrapped, run.t, _flat(run, run.R, run.Y))
+        self.tracker = EventTracker(wrapped, run.t, _flat(run.R, run.Y))
 
     def check(self, run: _Run, t_old, attitude_old, Y_old, t_new) -> bool:
         """After a step: record crossings; on a terminal one move ``run`` there, True."""
 
         def sol(t):
             if t == t_old:
-                return _flat(run, _matrix(run, attitude_old), Y_old)
+                return _flat(_matrix(run, attitude_old), Y_old)
             attitude, Y, _ = step(run.dynamics, run.method, t_old, attitude_old, Y_old, t - t_old)
-            return _flat(run, _matrix(run, attitude), Y)
+            return _flat(_matrix(run, attitude), Y)
 
-        t_stop = self.tracker.update(t_old, t_new, _flat(run, run.R, run.Y), sol)
+        t_stop = self.tracker.update(t_old, t_new, _flat(run.R, run.Y), sol)
         if t_stop is None:
             return False
         z = sol(t_stop)
