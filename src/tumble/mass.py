@@ -343,6 +343,18 @@ def hex_prism(
     return _axisymmetric(m, 5 * m * a**2 / 12, m * (5 * a**2 / 24 + L**2 / 12), axis, center)
 
 
+def validate_torus_radii(major_radius: float, minor_radius: float) -> tuple[float, float]:
+    """``(R, r)`` of a ring torus: both positive and ``r < R``; else a ValueError naming them."""
+    R = validate_positive(major_radius, name="major_radius")
+    r = validate_positive(minor_radius, name="minor_radius")
+    if r >= R:
+        raise ValueError(
+            f"minor_radius must be less than major_radius ({R!r}) for a ring torus; "
+            f"got minor_radius={minor_radius!r}"
+        )
+    return R, r
+
+
 def torus(
     major_radius: float,
     minor_radius: float,
@@ -367,13 +379,7 @@ def torus(
     >>> np.round(torus(1.0, 0.5, density=1.0).inertia.diagonal(), 6)
     array([3.238464, 3.238464, 5.860078])
     """
-    R = validate_positive(major_radius, name="major_radius")
-    r = validate_positive(minor_radius, name="minor_radius")
-    if r >= R:
-        raise ValueError(
-            f"minor_radius must be less than major_radius ({R!r}) for a ring torus; "
-            f"got minor_radius={minor_radius!r}"
-        )
+    R, r = validate_torus_radii(major_radius, minor_radius)
     m = _mass(2 * np.pi**2 * R * r**2, density, mass)
     return _axisymmetric(m, m * (R**2 + 0.75 * r**2), m * (R**2 / 2 + 5 * r**2 / 8), axis, center)
 

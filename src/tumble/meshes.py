@@ -10,8 +10,6 @@ in :mod:`tumble.mass`.
 
 from __future__ import annotations
 
-import os
-import tempfile
 from os import PathLike
 from pathlib import Path
 
@@ -19,7 +17,8 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike
 
-from tumble.mass import axis_vector, validate_point, validate_positive
+from tumble.io import atomic_write
+from tumble.mass import axis_vector, validate_point, validate_positive, validate_torus_radii
 from tumble.so3 import validate_rotation
 
 DEFAULT_SECTIONS = 64
@@ -75,13 +74,7 @@ def torus(
     >>> round(float(torus(1.0, 0.5, 64).volume), 4)  # exact 2π²Rr² = 4.9348
     4.919
     """
-    R = validate_positive(major_radius, name="major_radius")
-    r = validate_positive(minor_radius, name="minor_radius")
-    if r >= R:
-        raise ValueError(
-            f"minor_radius must be less than major_radius ({R!r}) for a ring torus; "
-            f"got minor_radius={minor_radius!r}"
-        )
+    R, r = validate_torus_radii(major_radius, minor_radius)
     n = _sections(sections, "sections")
     k = n if minor_sections is None else _sections(minor_sections, "minor_sections")
     return trimesh.creation.torus(
@@ -304,12 +297,4 @@ def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
     file_type = _suffix(file, SAVE_FORMATS, "path")
     if not file.parent.is_dir():
         raise ValueError(f"path must be in an existing folder; got {str(path)!r}")
-    handle, temporary = tempfile.mkstemp(dir=file.parent, suffix=file.suffix)
-    os.close(handle)
-    try:
-        mesh.export(temporary, file_type=file_type)
-        os.replace(temporary, file)
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
-    return file
+    return atomic_write(file, lambda temporary: mesh.export(temporary, file_type=file_type))

@@ -1,23 +1,26 @@
-"""Shared matplotlib set-up: the Agg backend, imported only when a picture is drawn."""
+"""Shared matplotlib set-up: figures on the Agg canvas, without pyplot's global state.
+
+matplotlib is imported only when a picture is drawn, and no backend is switched: each figure
+gets its own Agg canvas, so drawing works headless and leaves the caller's pyplot alone.
+"""
 
 from __future__ import annotations
 
 from pathlib import Path
 
-
-def new_figure(rows: int = 1, cols: int = 1, **kwargs):
-    """A figure and its axes on the Agg backend (no display needed)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt.subplots(rows, cols, **kwargs)
+DPI = 110
 
 
-def save(fig, path: str | Path) -> None:
-    """Write ``fig`` to ``path`` (format from the suffix) and free it."""
-    import matplotlib.pyplot as plt
+def new_figure(rows: int = 1, cols: int = 1, *, figsize=None, layout=None, **kwargs):
+    """A figure on its own Agg canvas and its axes (``Figure.subplots(rows, cols, **kwargs)``)."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
-    fig.savefig(path, dpi=110, bbox_inches="tight")
-    plt.close(fig)
+    fig = Figure(figsize=figsize, layout=layout)
+    FigureCanvasAgg(fig)
+    return fig, fig.subplots(rows, cols, **kwargs)
+
+
+def save(fig, path: str | Path, *, dpi: int = DPI, tight: bool = True) -> None:
+    """Write ``fig`` to ``path`` (format from the suffix)."""
+    fig.savefig(path, dpi=dpi, bbox_inches="tight" if tight else None)

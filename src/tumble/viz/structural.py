@@ -16,6 +16,8 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tumble.viz._figure import new_figure, save
+
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
@@ -34,18 +36,13 @@ def figure_writer(
     """A ``writer(path)`` that draws ``make(*args, **kwargs)`` and saves it at ``path``."""
 
     def write(path: Path) -> None:
-        make(*args, **kwargs).savefig(path, dpi=DPI)
+        save(make(*args, **kwargs), path, dpi=DPI, tight=False)
 
     return write
 
 
 def _new_figure(size: tuple[float, float] = FIGURE_SIZE) -> tuple[Figure, Axes]:
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=size, layout="constrained")
-    FigureCanvasAgg(figure)
-    return figure, figure.add_subplot()
+    return new_figure(figsize=size, layout="constrained")
 
 
 def energy_figure(response: Response, *, scale: float, title: str) -> Figure:
