@@ -7,9 +7,11 @@ A built-in scenario is a module in :mod:`tumble.scenarios` with
 * ``run(**options) -> ScenarioResult`` — pure computation, no files, no printing.
 
 The result carries the headline numbers (``summary``, JSON-serialisable), the arrays a
-reader may want (``data``), and the figures as ``(file name, writer)`` pairs; a writer is a
-callable that takes a path and draws one file there (the drawing lives in :mod:`tumble.viz`).
-:func:`tumble.io.write_run_folder` turns a result into a run folder.
+reader may want (``data``), the datasets written to ``data.nc`` (``datasets``, with the run's
+settings in ``attrs``), and the pictures as ``(file name, writer)`` pairs: ``figures`` (PNGs)
+and ``animations`` (``animation.gif``, ``view.html``; left out with ``--no-animation``). A
+writer is a callable that takes a path and draws one file there (the drawing lives in
+:mod:`tumble.viz`). :func:`tumble.io.write_run_folder` turns a result into a run folder.
 """
 
 from __future__ import annotations
@@ -36,9 +38,20 @@ class ScenarioResult:
         Arrays and objects (trajectories, datasets) for further use; not written as-is.
     figures : list of (str, callable)
         ``(file_name, writer)`` pairs; ``writer(path)`` draws the file at ``path``.
+    datasets : dict of str to xarray.Dataset
+        Written to ``data.nc``, one netCDF group per entry (a single entry named ``""`` is
+        the root group).
+    attrs : dict
+        The run's settings (method, step or tolerances, mass, inertia, …), written as the
+        root attributes of ``data.nc``; numbers, strings and lists of numbers only.
+    animations : list of (str, callable)
+        Like ``figures``, for the slower outputs (``animation.gif``, ``view.html``).
     """
 
     name: str
     summary: dict[str, Any]
     data: dict[str, Any] = field(default_factory=dict)
     figures: list[tuple[str, FigureWriter]] = field(default_factory=list)
+    datasets: dict[str, Any] = field(default_factory=dict)
+    attrs: dict[str, Any] = field(default_factory=dict)
+    animations: list[tuple[str, FigureWriter]] = field(default_factory=list)
