@@ -55,3 +55,37 @@ class ScenarioResult:
     datasets: dict[str, Any] = field(default_factory=dict)
     attrs: dict[str, Any] = field(default_factory=dict)
     animations: list[tuple[str, FigureWriter]] = field(default_factory=list)
+
+
+def rigid_animations(
+    trajectory, mesh, *, title: str, loads: tuple = (), animation: bool = True
+) -> list[tuple[str, FigureWriter]]:
+    """The moving-body outputs of a rigid-body run: ``animation.gif`` and ``view.html``.
+
+    Parameters
+    ----------
+    trajectory : tumble.rigid.Trajectory
+        The run to show.
+    mesh : trimesh.Trimesh
+        The body's surface in body coordinates (centre of mass at the origin).
+    title : str
+        Scenario and method, shown on both.
+    loads : tuple
+        Forces and impulses to draw as arrows (:mod:`tumble.rigid.forces`).
+    animation : bool
+        False returns no writers (``--no-animation``).
+    """
+    if not animation:
+        return []
+
+    def gif(path: Path) -> None:
+        from tumble.viz.animation import animate_body
+
+        animate_body(trajectory, mesh, path, title=title, loads=loads)
+
+    def html(path: Path) -> None:
+        from tumble.viz.html import html_viewer
+
+        html_viewer(trajectory, mesh, path, title=title, loads=loads)
+
+    return [("animation.gif", gif), ("view.html", html)]
