@@ -1,8 +1,17 @@
-"""Files appear complete or not at all."""
+"""Files appear complete or not at all; run folders read back with their attributes."""
 
+import json
+from pathlib import Path
+
+import numpy as np
 import pytest
+import xarray as xr
 
+import tumble
+from tumble import io, scenarios
 from tumble.io import atomic_write, write_json
+from tumble.rigid import Trajectory
+from tumble.scenarios._base import ScenarioResult
 
 
 def test_atomic_write_leaves_no_file_when_the_writer_crashes(tmp_path):
@@ -26,3 +35,91 @@ def test_atomic_write_keeps_the_old_file_when_the_writer_crashes(tmp_path):
         atomic_write(tmp_path / "summary.json", crash)
     assert (tmp_path / "summary.json").read_text() == '{\n  "a": 1\n}\n'
     assert [p.name for p in tmp_path.iterdir()] == ["summary.json"]
+
+
+def _t_handle(t_end=2.0):
+    return scenarios.get("t-handle").run(t_end=t_end, spins=[(1.0, 0.05, 0.0)])
+
+
+def test_data_nc_round_trips_with_its_attributes(tmp_path):
+    result = _t_handle()
+    io.write_run_folder(result, tmp_path, animation=False)
+    run = io.load(tmp_path)
+    assert run.groups == ["spin1", "mesh"]
+    assert run.attrs["scenario"] == "t-handle" and run.attrs["method"] == "rkmk4"
+    assert run.attrs["h"] == 0.01 and run.attrs["t_end"] == 2.0
+    body = result.data["body"]
+    assert run.attrs["mass"] == body.mass
+    np.testing.assert_array_equal(run.attrs["inertia"], np.ravel(body.inertia))
+    assert run.attrs["tumble_version"] == tumble.__version__
+    original = result.data["trajectories"][0]
+    back = Trajectory.from_xarray(run.dataset("spin1"))
+    np.testing.assert_array_equal(back.t, original.t)
+    np.testing.assert_array_equal(back.R, original.R)
+    np.testing.assert_array_equal(back.L_world, original.L_world)
+    assert run.dataset("spin1")["energy"].attrs["units"] == "J"
+    assert run.summary == json.loads(json.dumps({**result.summary, "files": run.summary["files"]}))
+
+
+def test_summary_lists_every_file_written_and_is_written_last(tmp_path):
+    io.write_run_folder(_t_handle(), tmp_path, animation=False)
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    on_disk = {p.name for p in tmp_path.iterdir()} - {"summary.json"}
+    assert set(summary["files"]) == on_disk
+    assert summary["files"][-1] == "data.nc"
+
+
+def test_a_crash_mid_write_leaves_only_whole_files(tmp_path):
+    good = _t_handle()
+
+    def crash(path):
+        path.write_bytes(b"\x89PNG half")
+        raise RuntimeError("killed while drawing")
+
+    broken = ScenarioResult(good.name, good.summary, figures=[good.figures[0], ("b.png", crash)])
+    with pytest.raises(RuntimeError, match="killed"):
+        io.write_run_folder(broken, tmp_path)
+    # the file written before the crash is whole; the crashed one and summary.json are absent
+    assert [p.name for p in tmp_path.iterdir()] == [good.figures[0][0]]
+    with pytest.raises(ValueError, match="summary.json is missing"):
+        io.load(tmp_path)
+
+
+def test_a_crash_while_writing_data_nc_leaves_no_partial_netcdf(tmp_path, monkeypatch):
+    def fail(self, path, **kwargs):
+        Path(path).write_bytes(b"\x89HDF half")
+        raise OSError("disk full")
+
+    monkeypatch.setattr(xr.DataTree, "to_netcdf", fail)
+    with pytest.raises(OSError, match="disk full"):
+        io.write_run_folder(_t_handle(), tmp_path, animation=False)
+    names = {p.name for p in tmp_path.iterdir()}
+    assert "data.nc" not in names and "summary.json" not in names
+    assert not [n for n in names if "partial" in n]
+
+
+def test_load_names_what_is_missing(tmp_path):
+    with pytest.raises(ValueError, match="summary.json is missing"):
+        io.load(tmp_path)
+    (tmp_path / "summary.json").write_text("{}")
+    with pytest.raises(ValueError, match="data.nc is missing"):
+        io.load(tmp_path)
+    (tmp_path / "data.nc").write_bytes(b"not netcdf")
+    with pytest.raises(ValueError, match="could not be read"):
+        io.load(tmp_path / "data.nc")
+
+
+def test_dataset_needs_a_name_when_there_are_several(tmp_path):
+    io.write_run_folder(_t_handle(), tmp_path, animation=False)
+    run = io.load(tmp_path)
+    with pytest.raises(ValueError, match=r"ambiguous.*spin1"):
+        run.dataset()
+    with pytest.raises(ValueError, match="spin9"):
+        run.dataset("spin9")
+
+
+def test_netcdf_attrs_keep_numbers_and_encode_the_rest():
+    attrs = io.netcdf_attrs({"h": 0.1, "ok": True, "skip": None, "v": [1, 2], "m": ["a", "b"]})
+    assert attrs["h"] == 0.1 and attrs["ok"] == 1 and "skip" not in attrs
+    np.testing.assert_array_equal(attrs["v"], [1, 2])
+    assert json.loads(attrs["m"]) == ["a", "b"]

@@ -1,8 +1,27 @@
 """Run folders: every file written whole or not at all.
 
-A run folder holds ``summary.json`` (the headline numbers) and the scenario's figures. Each file
-is first written under a temporary name in the same folder and then renamed, so a crash never
-leaves half a file behind.
+A run folder holds
+
+* ``data.nc`` — the trajectories as netCDF-4 (h5netcdf): one group per run, the run's settings
+  (scenario, method, step or tolerances, mass, inertia, tumble version) as root attributes;
+* the scenario's PNGs, and ``animation.gif`` and ``view.html`` for the moving body;
+* ``summary.json`` — the headline numbers and the list of files, written last.
+
+Each file is first written under a temporary name in the same folder and then renamed, so a
+crash never leaves half a file behind (a folder without ``summary.json`` was interrupted).
+:func:`load` reads a folder back.
+
+Examples
+--------
+>>> import tempfile
+>>> from tumble import io, scenarios
+>>> result = scenarios.get("projectile").run(h=0.5)
+>>> folder = io.write_run_folder(result, tempfile.mkdtemp())
+>>> run = io.load(folder)
+>>> run.attrs["scenario"], run.summary["method"]
+('projectile', 'rk4')
+>>> round(float(run.dataset()["x"][-1]), 1) > 25000
+True
 """
 
 from __future__ import annotations
@@ -10,8 +29,12 @@ from __future__ import annotations
 import json
 import logging
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
+
+import numpy as np
 
 from tumble.scenarios._base import ScenarioResult
 
@@ -54,8 +77,68 @@ def prepare_folder(out: str | Path, *, force: bool = False) -> Path:
     return out
 
 
-def write_run_folder(result: ScenarioResult, out: str | Path, *, force: bool = False) -> Path:
-    """Write a scenario's ``summary.json`` and figures into the folder ``out``.
+DATA_FILE = "data.nc"
+SUMMARY_FILE = "summary.json"
+
+
+def _attribute(value: Any) -> Any:
+    """A netCDF-storable attribute: numbers, strings and flat numeric arrays as they are."""
+    if isinstance(value, bool | np.bool_):
+        return int(value)
+    if isinstance(value, str | int | float | np.integer | np.floating):
+        return value
+    array = np.asarray(value) if isinstance(value, list | tuple | np.ndarray) else None
+    if array is not None and array.dtype.kind in "iuf" and array.size:
+        return array.ravel()
+    return json.dumps(value, default=str)
+
+
+def netcdf_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
+    """``attrs`` made storable: None dropped, bools as 0/1, nested data as JSON text."""
+    return {key: _attribute(value) for key, value in attrs.items() if value is not None}
+
+
+def write_dataset(path: str | Path, datasets: Mapping[str, Any], attrs: Mapping[str, Any]) -> Path:
+    """Write ``datasets`` as one netCDF-4 file, one group each, ``attrs`` on the root group.
+
+    A single dataset named ``""`` becomes the root group itself. The file is written atomically.
+    """
+    import xarray as xr
+
+    import tumble
+
+    groups = {
+        f"/{name}" if name else "/": ds.assign_attrs(netcdf_attrs(ds.attrs))
+        for name, ds in datasets.items()
+    }
+    root = groups.pop("/", xr.Dataset())
+    root = root.assign_attrs(netcdf_attrs({**attrs, "tumble_version": tumble.__version__}))
+    tree = xr.DataTree.from_dict({"/": root, **groups})
+    return atomic_write(path, lambda tmp: tree.to_netcdf(tmp, engine="h5netcdf"))
+
+
+def write_run_folder(
+    result: ScenarioResult,
+    out: str | Path,
+    *,
+    force: bool = False,
+    animation: bool = True,
+    on_file: Callable[[str], None] | None = None,
+) -> Path:
+    """Write a scenario's run folder: pictures, ``data.nc``, then ``summary.json``.
+
+    Parameters
+    ----------
+    result : ScenarioResult
+        What :func:`tumble.scenarios.get(name).run() <tumble.scenarios.get>` returned.
+    out : path
+        The folder; created if missing, refused if it holds files unless ``force``.
+    force : bool
+        Overwrite files in an existing folder.
+    animation : bool
+        Write ``result.animations`` (``animation.gif``, ``view.html``) too.
+    on_file : callable, optional
+        Called with each file's name before it is written (for progress display).
 
     Returns
     -------
@@ -63,8 +146,82 @@ def write_run_folder(result: ScenarioResult, out: str | Path, *, force: bool = F
         The folder.
     """
     out = prepare_folder(out, force=force)
-    for name, writer in result.figures:
+    writers = list(result.figures) + (list(result.animations) if animation else [])
+    files = []
+    notify = on_file or (lambda name: None)
+    for name, writer in writers:
         log.info("writing %s", out / name)
+        notify(name)
         atomic_write(out / name, writer)
-    write_json(out / "summary.json", result.summary)
+        files.append(name)
+    if result.datasets:
+        notify(DATA_FILE)
+        attrs = {"scenario": result.name, **result.attrs}
+        write_dataset(out / DATA_FILE, result.datasets, attrs)
+        files.append(DATA_FILE)
+    write_json(out / SUMMARY_FILE, {**result.summary, "files": files})
     return out
+
+
+@dataclass(frozen=True)
+class Run:
+    """A run folder read back by :func:`load`.
+
+    Attributes
+    ----------
+    path : Path
+        The folder.
+    summary : dict
+        ``summary.json``.
+    data : xarray.DataTree
+        ``data.nc``, loaded into memory (one group per run).
+    """
+
+    path: Path
+    summary: dict
+    data: Any
+
+    @property
+    def attrs(self) -> dict:
+        """The run's settings: the root attributes of ``data.nc``."""
+        return dict(self.data.attrs)
+
+    @property
+    def groups(self) -> list[str]:
+        """Names of the runs in ``data.nc`` (``""`` is the root group)."""
+        return [node.path.lstrip("/") for node in self.data.subtree if node.data_vars]
+
+    def dataset(self, name: str | None = None):
+        """The ``xarray.Dataset`` of one run (the only one when ``name`` is None)."""
+        groups = self.groups
+        if name is None:
+            if len(groups) != 1:
+                raise ValueError(f"name=None is ambiguous: this run has the groups {groups}")
+            name = groups[0]
+        if name not in groups:
+            raise ValueError(f"name={name!r} is not a run in {self.path}; choose one of {groups}")
+        return self.data[f"/{name}" if name else "/"].to_dataset()
+
+
+def load(path: str | Path) -> Run:
+    """Read a run folder (or its ``data.nc``) written by :func:`write_run_folder`.
+
+    Raises
+    ------
+    ValueError
+        If the folder or its ``summary.json`` / ``data.nc`` is missing or unreadable.
+    """
+    import xarray as xr
+
+    path = Path(path)
+    folder = path.parent if path.name == DATA_FILE else path
+    for name in (SUMMARY_FILE, DATA_FILE):
+        if not (folder / name).is_file():
+            raise ValueError(f"path={str(path)!r} is not a complete run folder: {name} is missing")
+    try:
+        summary = json.loads((folder / SUMMARY_FILE).read_text(encoding="utf-8"))
+        with xr.open_datatree(folder / DATA_FILE, engine="h5netcdf") as tree:
+            data = tree.load().copy()
+    except (OSError, ValueError) as error:
+        raise ValueError(f"path={str(path)!r} could not be read: {error}") from error
+    return Run(folder, summary, data)

@@ -1,4 +1,4 @@
-"""Trajectory → xarray.Dataset (xarray imported only here)."""
+"""Trajectory ↔ xarray.Dataset (xarray imported only here)."""
 
 from __future__ import annotations
 
@@ -44,3 +44,31 @@ def trajectory_dataset(trajectory):
         "component": ["w", "x", "y", "z"],
     }
     return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def trajectory_from_dataset(dataset):
+    """The :class:`~tumble.rigid.Trajectory` a :func:`trajectory_dataset` was made from.
+
+    Times, states, the body (mass, inertia), method, settings, status and message come back;
+    step counts and event times are not stored.
+    """
+    from tumble.rigid.body import RigidBody
+    from tumble.rigid.trajectory import Trajectory
+
+    attrs = dataset.attrs
+    inertia = np.asarray(attrs["inertia"], dtype=float).reshape(3, 3)
+    body = RigidBody(float(attrs["mass"]), inertia, allow_unphysical=True)
+    values = {name: np.asarray(dataset[name].values) for name in ("x", "v", "R", "L_world", "q")}
+    return Trajectory(
+        t=np.asarray(dataset["time"].values),
+        x=values["x"],
+        v=values["v"],
+        R=values["R"],
+        L_world=values["L_world"],
+        body=body,
+        method=str(attrs["method"]),
+        settings=json.loads(attrs.get("settings", "{}")),
+        status=int(attrs.get("status", 0)),
+        message=str(attrs.get("message", "")),
+        q_raw=values["q"],
+    )

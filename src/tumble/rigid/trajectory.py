@@ -111,3 +111,21 @@ class Trajectory:
         from tumble.rigid._xarray import trajectory_dataset
 
         return trajectory_dataset(self)
+
+    @classmethod
+    def from_xarray(cls, dataset) -> Trajectory:
+        """The trajectory back from :meth:`to_xarray`'s dataset (e.g. a run's ``data.nc``).
+
+        Step counts and event times are not stored and come back as 0 and ``[]``.
+
+        Examples
+        --------
+        >>> from tumble.rigid import RigidBody, simulate
+        >>> run = simulate(RigidBody(1.0, [1.0, 2.0, 3.0]), 1.0, h=0.1, omega0=[0, 1, 0.1])
+        >>> back = Trajectory.from_xarray(run.to_xarray())
+        >>> bool(np.array_equal(back.R, run.R)), bool(np.allclose(back.energy, run.energy))
+        (True, True)
+        """
+        from tumble.rigid._xarray import trajectory_from_dataset
+
+        return trajectory_from_dataset(dataset)

@@ -16,10 +16,12 @@ writer is a callable that takes a path and draws one file there (the drawing liv
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 FigureWriter = Callable[[Path], None]
 
@@ -89,3 +91,44 @@ def rigid_animations(
         html_viewer(trajectory, mesh, path, title=title, loads=loads)
 
     return [("animation.gif", gif), ("view.html", html)]
+
+
+SHOWCASE_ORDER = ("rkmk4", "rkmk45", "rk4-quat", "lie-euler")
+"""Which run of a multi-method scenario the animation shows: the first of these present."""
+
+
+def showcase(runs: Mapping[str, Any]) -> str:
+    """The name of the run to animate: the best-behaved method present, else the first."""
+    return next((name for name in SHOWCASE_ORDER if name in runs), next(iter(runs)))
+
+
+def rigid_datasets(runs: Mapping[str, Any], mesh=None, shown: str | None = None) -> dict[str, Any]:
+    """One ``xarray.Dataset`` per trajectory, keyed like ``runs`` (the groups of ``data.nc``).
+
+    With ``mesh``, a group ``mesh`` holds its ``vertices`` (m, body frame) and ``faces``, and
+    names the run the animation shows (attribute ``shows``), so ``tumble view`` can draw it
+    again from ``data.nc`` alone.
+    """
+    datasets = {name: run.to_xarray() for name, run in runs.items()}
+    if mesh is not None:
+        datasets["mesh"] = mesh_dataset(mesh, shows=shown or showcase(runs))
+    return datasets
+
+
+def mesh_dataset(mesh, *, shows: str):
+    """A triangle mesh as an ``xarray.Dataset`` (``vertices`` in m, ``faces`` as indices)."""
+    import xarray as xr
+
+    return xr.Dataset(
+        {
+            "vertices": (("vertex", "axis"), np.asarray(mesh.vertices), {"units": "m"}),
+            "faces": (("face", "corner"), np.asarray(mesh.faces, dtype=np.int64)),
+        },
+        coords={"axis": ["x", "y", "z"]},
+        attrs={"shows": shows},
+    )
+
+
+def rigid_attrs(body, **settings: Any) -> dict[str, Any]:
+    """The root attributes of ``data.nc`` for a rigid-body scenario: settings, mass, inertia."""
+    return {**settings, "mass": float(body.mass), "inertia": np.ravel(body.inertia).tolist()}

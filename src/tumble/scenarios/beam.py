@@ -102,7 +102,25 @@ def run(
         _summary(settings, beam, omega, dt, critical, runs, sweeps, scale),
         data={"system": beam, "runs": runs, "sweeps": sweeps, "frames": frames},
         figures=_figures(beam, runs, sweeps, scale, frame_every),
+        datasets={scheme: _dataset(response) for scheme, response in runs.items()},
+        attrs={**settings, "dt": dt, "schemes": list(runs)},
     )
+
+
+def _dataset(response):
+    """One scheme's run as an ``xarray.Dataset``: free-DOF state, energy and tip against time."""
+    import xarray as xr
+
+    state = ("time", "dof")
+    data_vars = {
+        "x": (state, response.x, {"units": "m or rad", "long_name": "free-DOF displacement"}),
+        "y": (state, response.y, {"units": "m/s or rad/s", "long_name": "free-DOF velocity"}),
+        "energy": ("time", response.energy, {"units": "J", "long_name": "total energy"}),
+        "tip": ("time", response.tip_displacement, {"units": "m", "long_name": "tip deflection"}),
+    }
+    attrs = {"scheme": response.scheme, "dt": response.dt, "status": response.status}
+    coords = {"time": ("time", response.t, {"units": "s"})}
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
 
 
 def exact_frequencies(
@@ -198,3 +216,77 @@ def _figures(beam, runs, sweeps, scale, every) -> list:
 def _number(value: float) -> float | None:
     """JSON has no inf or NaN: those become None."""
     return float(value) if np.isfinite(value) else None
+
+
+def stability(
+    *,
+    n_elements: int = 20,
+    sweep_steps: int = 1000,
+    schemes: tuple[str, ...] = structural.SEED_SCHEMES,
+    factors: tuple[float, ...] = SWEEP_FACTORS,
+) -> ScenarioResult:
+    """The cantilever's Δt sweep on its own (``tumble stability``): which schemes stay bounded.
+
+    Each scheme runs ``sweep_steps`` steps from rest under the tip load at
+    ``Δt = factor × 2/ω_max`` for each factor (:func:`tumble.structural.stability_sweep`);
+    the energy growth ``max (E − E₀)`` over the energy scale tells stable (< 1) from not.
+
+    Returns
+    -------
+    ScenarioResult
+        ``summary``: the critical step and its mode, and per scheme the growth and the
+        verdict at each Δt; figure ``stability_sweep.png``; dataset with ``energy_growth``
+        against (scheme, dt).
+
+    Examples
+    --------
+    >>> result = stability(n_elements=8, sweep_steps=500, schemes=("semi-implicit",),
+    ...                    factors=(0.9, 1.1))
+    >>> result.summary["schemes"]["semi-implicit"]["stable"]
+    [True, False]
+    """
+    validation.count("sweep_steps", sweep_steps)
+    if not schemes:
+        raise ValueError("schemes=() is not allowed: name at least one scheme")
+    beam = structural.cantilever(1.0, n_elements, 210e9, 7850.0, 0.01, 0.01, 1.0)
+    critical = structural.critical_dt(beam, "semi-implicit")
+    dts = critical.dt * np.asarray(factors, dtype=float)
+    sweeps = [structural.stability_sweep(beam, s, dts, sweep_steps) for s in schemes]
+    summary = {
+        "scenario": "stability",
+        "n_elements": n_elements,
+        "sweep_steps": sweep_steps,
+        "critical_dt_semi_implicit": critical.dt,
+        "critical_mode": critical.mode,
+        "factors": list(factors),
+        "dt": dts.tolist(),
+        "schemes": {
+            sweep.scheme: {
+                "energy_growth": [_number(g) for g in sweep.energy_growth],
+                "stable": sweep.stable.tolist(),
+            }
+            for sweep in sweeps
+        },
+    }
+    title = f"{NAME} — stability sweep, {n_elements} elements, {sweep_steps} steps"
+    return ScenarioResult(
+        "stability",
+        summary,
+        data={"system": beam, "sweeps": sweeps},
+        figures=[
+            ("stability_sweep.png", viz.figure_writer(viz.stability_figure, sweeps, title=title))
+        ],
+        datasets={"": _sweep_dataset(sweeps)},
+        attrs={"n_elements": n_elements, "sweep_steps": sweep_steps, "critical_dt": critical.dt},
+    )
+
+
+def _sweep_dataset(sweeps):
+    """Energy growth against (scheme, dt) as an ``xarray.Dataset``."""
+    import xarray as xr
+
+    growth = np.array([sweep.energy_growth for sweep in sweeps])
+    return xr.Dataset(
+        {"energy_growth": (("scheme", "dt"), growth, {"units": "1"})},
+        coords={"scheme": [s.scheme for s in sweeps], "dt": ("dt", sweeps[0].dt, {"units": "s"})},
+    )

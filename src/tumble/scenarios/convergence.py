@@ -142,7 +142,30 @@ def run(
     ]
     title = f"{NAME} — I = diag(2, 1, 2/3), L = (cos 1.1, 0, sin 1.1), T = {t_end:g} s"
     writer = partial(rigid.convergence, studies, title=title)
-    return ScenarioResult(NAME, summary, {"step_sizes": step_sizes}, [("convergence.png", writer)])
+    return ScenarioResult(
+        NAME,
+        summary,
+        {"step_sizes": step_sizes},
+        [("convergence.png", writer)],
+        datasets={"": _dataset(step_sizes, results)},
+        attrs={"methods": list(methods), "t_end": t_end, "inertia": list(INERTIA), "L0": list(L0)},
+    )
+
+
+def _dataset(step_sizes: np.ndarray, results: dict):
+    """Final errors against (method, h), with the observed orders, as an ``xarray.Dataset``."""
+    import xarray as xr
+
+    methods = list(results)
+    errors = np.array([results[method]["errors"] for method in methods])
+    orders = np.array([results[method]["observed_order"] for method in methods])
+    return xr.Dataset(
+        {
+            "error": (("method", "h"), errors, {"units": "1", "long_name": "|R(T) − R_exact|_F"}),
+            "observed_order": ("method", orders, {"units": "1"}),
+        },
+        coords={"method": methods, "h": ("h", step_sizes, {"units": "s"})},
+    )
 
 
 def _study(method: str, step_sizes: np.ndarray, t_end: float) -> dict:
@@ -154,3 +177,8 @@ def _study(method: str, step_sizes: np.ndarray, t_end: float) -> dict:
         "errors": errors.tolist(),
         "last_halving_ratio": float(errors[finest[1]] / errors[finest[0]]),
     }
+
+
+def free_body() -> tuple[RigidBody, np.ndarray]:
+    """Hairer–Lubich–Wanner's body and ω(0) = I⁻¹ L0, for ``tumble compare convergence``."""
+    return RigidBody(1.0, INERTIA, allow_unphysical=True), np.array(L0) / np.array(INERTIA)

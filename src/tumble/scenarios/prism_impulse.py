@@ -27,7 +27,13 @@ from numpy.typing import ArrayLike
 
 from tumble import mass, meshes
 from tumble.rigid import Impulse, RigidBody, simulate
-from tumble.scenarios._base import ScenarioResult
+from tumble.scenarios._base import (
+    ScenarioResult,
+    rigid_animations,
+    rigid_attrs,
+    rigid_datasets,
+    showcase,
+)
 from tumble.viz import rigid
 
 NAME = "prism-impulse"
@@ -123,7 +129,8 @@ def run(
         largest component difference from the closed forms), ``energy_after``,
         ``energy_drift`` (largest ``|E/E₀ − 1|`` after the hit), ``max_momentum_error``
         (``|L − L₀|``) and ``max_orthogonality_error``. Figures ``snapshots.png``,
-        ``drift.png`` and ``rotation_grid.png``.
+        ``drift.png`` and ``rotation_grid.png``; one dataset per method; ``animation.gif``
+        and ``view.html`` (the hit drawn as an arrow).
 
     Examples
     --------
@@ -150,7 +157,23 @@ def run(
     summary = _summary(body, impulse, center, runs, h, t_end)
     title = f"{NAME} — J = {duration} s × (f1 − f0), h = {h} s"
     figures = _figures(mesh, center, hit_from, f1, runs, title)
-    return ScenarioResult(NAME, summary, {"trajectories": runs, "body": body}, figures)
+    shown, body_mesh = showcase(runs), mesh.copy().apply_translation(-center)
+    return ScenarioResult(
+        NAME,
+        summary,
+        {"trajectories": runs, "body": body},
+        figures,
+        datasets=rigid_datasets(runs, body_mesh, shown),
+        attrs=rigid_attrs(
+            body, methods=list(methods), h=h, t_end=t_end, impulse=impulse.impulse.tolist()
+        ),
+        animations=rigid_animations(
+            runs[shown],
+            body_mesh,
+            title=f"{title}, {shown}",
+            loads=(impulse,),
+        ),
+    )
 
 
 def _expected(body: RigidBody, impulse: Impulse, center: np.ndarray) -> dict:

@@ -54,7 +54,8 @@ def run(
     -------
     ScenarioResult
         ``summary`` with ``impact_time`` (s), ``range`` (m), ``max_height`` (m); ``data``
-        with the :class:`~tumble.ode.OdeResult`; one figure, ``trajectory.png``.
+        with the :class:`~tumble.ode.OdeResult`; one figure, ``trajectory.png``; the flight
+        (x, y, vx, vy against time) as the dataset.
 
     Examples
     --------
@@ -88,7 +89,22 @@ def run(
         summary=summary,
         data={"ode": ode},
         figures=[("trajectory.png", partial(_draw, ode=ode, summary=summary))],
+        datasets={"": _dataset(ode)},
+        attrs={"method": method, "h": h, "speed": speed, "angle": angle, "g": g},
     )
+
+
+def _dataset(ode):
+    """The flight as an ``xarray.Dataset``: position and velocity against time."""
+    import xarray as xr
+
+    names = [("x", "m", "horizontal position"), ("y", "m", "height")]
+    names += [("vx", "m/s", "horizontal velocity"), ("vy", "m/s", "vertical velocity")]
+    data_vars = {
+        name: ("time", row, {"units": units, "long_name": text})
+        for (name, units, text), row in zip(names, ode.y, strict=True)
+    }
+    return xr.Dataset(data_vars, coords={"time": ("time", ode.t, {"units": "s"})})
 
 
 def _draw(path, *, ode, summary) -> None:

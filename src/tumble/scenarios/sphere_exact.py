@@ -19,9 +19,15 @@ from functools import partial
 
 import numpy as np
 
-from tumble import exact
+from tumble import exact, meshes
 from tumble.rigid import RigidBody, Trajectory, simulate
-from tumble.scenarios._base import ScenarioResult
+from tumble.scenarios._base import (
+    ScenarioResult,
+    rigid_animations,
+    rigid_attrs,
+    rigid_datasets,
+    showcase,
+)
 from tumble.viz import rigid
 
 NAME = "sphere-exact"
@@ -96,11 +102,15 @@ def run(
     }
     summary = _summary(runs, errors, h, t_end)
     title = f"{NAME} — I = Id, ω₀ = (1, 0, 0) rad/s, h = {h} s"
+    shown, mesh = showcase(runs), _mesh()
     return ScenarioResult(
         name=NAME,
         summary=summary,
         data={"trajectories": runs, "errors": errors},
         figures=_figures(runs, errors, title),
+        datasets=rigid_datasets(runs, mesh, shown),
+        attrs=rigid_attrs(body, methods=list(methods), h=h, rtol=rtol, t_end=t_end),
+        animations=rigid_animations(runs[shown], mesh, title=f"{title}, {shown}"),
     )
 
 
@@ -140,3 +150,16 @@ def _figures(runs: dict, errors: dict, title: str) -> list:
         ("rotation_grid.png", partial(rigid.rotation_grid, grid, title=title)),
         ("drift.png", partial(rigid.drift, list(runs.items()), title=title)),
     ]
+
+
+def _mesh():
+    """A coarse icosphere (its facets show the turning) of the unit-inertia, 1 kg sphere.
+
+    ``I = (2/5) m r² = 1`` gives ``r = sqrt(5/2)`` m.
+    """
+    return meshes.sphere(np.sqrt(2.5), 1)
+
+
+def free_body() -> tuple[RigidBody, np.ndarray]:
+    """The unit sphere spun about x, for ``tumble compare sphere-exact``."""
+    return RigidBody(1.0, np.eye(3)), np.array(OMEGA0)

@@ -20,9 +20,9 @@ from functools import partial
 
 import numpy as np
 
-from tumble import exact, mass
+from tumble import exact, mass, meshes
 from tumble.rigid import RigidBody, Trajectory, simulate
-from tumble.scenarios._base import ScenarioResult
+from tumble.scenarios._base import ScenarioResult, rigid_animations, rigid_attrs, rigid_datasets
 from tumble.viz import rigid
 
 NAME = "t-handle"
@@ -133,7 +133,9 @@ def run(
         ``max_orthogonality_error``, ``energy_drift`` (largest ``|E/E₀ − 1|``),
         ``momentum_drift`` (largest ``|L − L₀|/|L₀|``) and ``error_vs_exact``
         (``‖R − R_exact‖_F`` at the end). Figures: ``rotation_grid_spin<k>.png``,
-        ``euler_angles_spin<k>.png`` for k = 1, 2, …, ``angular_velocity.png``, ``drift.png``.
+        ``euler_angles_spin<k>.png`` for k = 1, 2, …, ``angular_velocity.png``, ``drift.png``;
+        datasets ``spin<k>``; ``animation.gif`` and ``view.html`` of the intermediate-axis
+        spin (the flip).
 
     Examples
     --------
@@ -159,12 +161,29 @@ def run(
         "spins": [result for result, _ in results],
     }
     crossings = [marks for _, marks in results]
+    shown, mesh = _showcase(summary["spins"]), meshes.t_handle()
+    setting = f"{method}, h = {h} s" if h is not None else method
     return ScenarioResult(
         name=NAME,
         summary=summary,
         data={"trajectories": runs, "body": body, "crossings": crossings},
         figures=_figures(summary, runs, crossings),
+        datasets=rigid_datasets(
+            {f"spin{k}": run for k, run in enumerate(runs, start=1)}, mesh, f"spin{shown + 1}"
+        ),
+        attrs=rigid_attrs(body, method=method, h=h, rtol=rtol, t_end=t_end),
+        animations=rigid_animations(
+            runs[shown],
+            mesh,
+            title=f"{NAME} — {_label(summary['spins'][shown])}\n{setting}",
+        ),
     )
+
+
+def _showcase(spins: list[dict]) -> int:
+    """The spin to animate: the first about the intermediate axis (it flips), else the first."""
+    roles = [spin["axis_role"] for spin in spins]
+    return next((k for k, role in enumerate(roles) if role.startswith("intermediate")), 0)
 
 
 def _role(inertia: np.ndarray, omega0: np.ndarray) -> tuple[str, str]:
@@ -247,3 +266,8 @@ def _figures(summary: dict, runs: list[Trajectory], crossings: list) -> list:
     ]
     figures.append(("drift.png", partial(rigid.drift, drifts, title=f"{NAME} — {setting}")))
     return figures
+
+
+def free_body() -> tuple[RigidBody, np.ndarray]:
+    """The T-handle and its flipping spin, for ``tumble compare t-handle`` (work–precision)."""
+    return RigidBody.from_mass_properties(mass.t_handle()), np.array(SPINS[0])

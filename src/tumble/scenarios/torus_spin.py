@@ -22,9 +22,15 @@ from functools import partial
 
 import numpy as np
 
-from tumble import exact, mass
+from tumble import exact, mass, meshes
 from tumble.rigid import RigidBody, simulate
-from tumble.scenarios._base import ScenarioResult
+from tumble.scenarios._base import (
+    ScenarioResult,
+    rigid_animations,
+    rigid_attrs,
+    rigid_datasets,
+    showcase,
+)
 from tumble.viz import rigid
 
 NAME = "torus-spin"
@@ -79,7 +85,8 @@ def run(
         (``‖R − R_exact‖_F`` at ``t_end``), ``energy_drift`` (largest ``|E/E₀ − 1|``) and
         ``t_reached`` (s; a method that overflows stops early and its numbers are None).
         ``data`` holds the trajectories; figures ``drift.png``, ``error_vs_exact.png`` and
-        ``rotation_grid.png`` (the first :data:`GRID_SPAN` s).
+        ``rotation_grid.png`` (the first :data:`GRID_SPAN` s); one dataset per method;
+        ``animation.gif`` and ``view.html`` of the best-behaved method's run.
 
     Examples
     --------
@@ -99,11 +106,19 @@ def run(
     }
     summary = _summary(body, runs, exact_R, h, t_end, omega0)
     title = f"{NAME} — free torus, ω₀ = {tuple(float(w) for w in omega0)} rad/s, h = {h} s"
+    shown, mesh = showcase(runs), meshes.torus(major_radius, minor_radius)
     return ScenarioResult(
         name=NAME,
         summary=summary,
         data={"trajectories": runs, "body": body},
         figures=_figures(body, runs, exact_R, title, omega0),
+        datasets=rigid_datasets(runs, mesh, shown),
+        attrs=rigid_attrs(body, methods=list(methods), h=h, t_end=t_end, omega0=list(omega0)),
+        animations=rigid_animations(
+            runs[shown],
+            mesh,
+            title=f"{title}, {shown}",
+        ),
     )
 
 
@@ -178,3 +193,8 @@ def _figures(body, runs, exact_R, title, omega0) -> list:
         ("error_vs_exact.png", partial(rigid.error_vs_exact, errors, title=title)),
         ("rotation_grid.png", partial(rigid.rotation_grid, grid, title=title)),
     ]
+
+
+def free_body() -> tuple[RigidBody, np.ndarray]:
+    """The seeds' torus and ω(0) = (1, 1, 1) rad/s, for ``tumble compare torus-spin``."""
+    return RigidBody.from_mass_properties(mass.torus(1.0, 0.5, density=1.0)), np.array(OMEGA0)
