@@ -4,7 +4,7 @@ Every function builds a :class:`matplotlib.figure.Figure` on the Agg canvas (mat
 imported inside the functions, never at module import, and pyplot's global state is not
 used). :func:`figure_writer` turns a figure function into the ``writer(path)`` that a
 :class:`~tumble.scenarios._base.ScenarioResult` lists; :func:`beam_frames` renders RGB
-arrays for an animation.
+arrays for an animation and :func:`beam_animation` writes them as a GIF (or MP4).
 """
 
 from __future__ import annotations
@@ -168,8 +168,63 @@ def beam_frames(
         axes.set_ylabel(f"y [m], displacement × {magnification:.3g}")
         axes.set_title(f"{title}, t = {time:.4f} s", fontsize=10)
         figure.canvas.draw()
+        figure.set_layout_engine("none")  # same labels every frame: keep the first layout
         frames.append(np.asarray(figure.canvas.buffer_rgba())[..., :3].copy())
     return frames
+
+
+def beam_animation(
+    system: LinearSystem,
+    response: Response,
+    path: str | Path,
+    *,
+    every: int = 10,
+    title: str,
+    fps: float = 20,
+    size: tuple[int, int] = (640, 360),
+) -> Path:
+    """Write the moving beam as an animation: :func:`beam_frames` of every ``every``-th record.
+
+    Each frame is the deformed frame ``nodes + m u`` on fixed axes (one magnification ``m``
+    for the whole run, in the y label) over the undeformed one, titled ``"{title} —
+    {scheme}, t = … s"``. Records that are not finite (the last one of a diverged run) are
+    left out.
+
+    Parameters
+    ----------
+    system : LinearSystem
+    response : Response
+        From :func:`tumble.structural.integrate`; its records are every ``record_every``
+        steps, so a frame is every ``every × record_every`` steps.
+    path : str or Path
+        ``.gif`` or ``.mp4`` (by suffix only; see :func:`tumble.viz.animation.write_animation`).
+    every : int
+        Keep every this many records, ≥ 1.
+    title : str
+        Names the scenario; the scheme's name is appended.
+    fps : float
+        Frames per second.
+    size : (int, int)
+        Width and height in pixels.
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    from tumble.viz.animation import animation_format, write_animation
+
+    animation_format(path)  # refuse a bad suffix before drawing
+    if isinstance(every, bool) or not isinstance(every, int | np.integer) or every < 1:
+        raise ValueError(f"every={every!r} must be an integer ≥ 1 (records per frame)")
+    t, x = np.asarray(response.t)[::every], np.asarray(response.x)[::every]
+    finite = np.all(np.isfinite(x), axis=1)
+    if not np.any(finite):
+        raise ValueError("response has no finite record to draw")
+    images = beam_frames(
+        system, t[finite], x[finite], title=f"{title} — {response.scheme}", size=size
+    )
+    return write_animation(images, path, fps=fps)
 
 
 def _magnification(system: LinearSystem, x: NDArray) -> float:

@@ -1,0 +1,195 @@
+"""Work–precision: what each rigid-body method's accuracy costs, on a torque-free body.
+
+Each fixed-step method runs with several step counts and the adaptive ``rkmk45`` with several
+tolerances; every run is timed and compared at the end with the exact attitude
+(:func:`tumble.exact.free_body_rotation`). The result is a list of
+:class:`WorkPrecisionPoint`; :func:`table` makes rows for printing and
+:func:`tumble.viz.work_precision.work_precision_figure` draws them.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from tumble.exact import free_body_rotation
+from tumble.rigid.body import RigidBody
+from tumble.rigid.methods import get_method
+from tumble.rigid.simulate import simulate
+
+STEPS = (50, 100, 200, 400, 800)
+"""Default step counts of the fixed-step methods over ``[0, t_end]``."""
+TOLERANCES = (1e-4, 1e-6, 1e-8, 1e-10)
+"""Default ``rtol`` (= ``atol``) of the adaptive method."""
+_KEEP_ENDS = 2**62
+"""``record_every`` so large that a run records only its first and last state."""
+
+
+@dataclass(frozen=True)
+class WorkPrecisionPoint:
+    """One timed run of one method.
+
+    Attributes
+    ----------
+    method : str
+        The method's name (:data:`tumble.rigid.METHODS`).
+    setting : float
+        The step ``h`` (s) of a fixed-step method, or ``rtol`` (= ``atol``) of an adaptive one.
+    steps : int
+        Accepted steps.
+    rejected : int
+        Rejected steps (adaptive methods; 0 otherwise).
+    seconds : float
+        Wall time of ``simulate``, the best of ``repeat`` runs (s).
+    error : float
+        ``‖R(T) − R_exact(T)‖_F``; ``inf`` if the run stopped on a non-finite state.
+    """
+
+    method: str
+    setting: float
+    steps: int
+    rejected: int
+    seconds: float
+    error: float
+
+    @property
+    def setting_name(self) -> str:
+        """``"rtol"`` for an adaptive method, ``"h"`` otherwise."""
+        return "rtol" if get_method(self.method).adaptive else "h"
+
+
+def work_precision(
+    body: RigidBody,
+    t_end: float,
+    methods: Sequence[str],
+    *,
+    omega0: ArrayLike,
+    steps: Sequence[int] = STEPS,
+    tolerances: Sequence[float] = TOLERANCES,
+    repeat: int = 3,
+) -> list[WorkPrecisionPoint]:
+    """Time each method at several accuracies and measure its error at ``t_end``.
+
+    A fixed-step method runs ``simulate(body, t_end, method=m, h=t_end/n, omega0=omega0)``
+    for each ``n`` in ``steps``; an adaptive one runs with ``rtol = atol = tol`` for each
+    ``tol`` in ``tolerances`` (one number sets the accuracy of the attitude, measured in
+    radians against 1, and of the momentum). Each run records only its ends. Its error is
+
+    .. math::
+
+        e = \\lVert R(T) - R_{\\text{exact}}(T) \\rVert_F
+
+    with ``R_exact`` from :func:`tumble.exact.free_body_rotation` (``R(0) = I``). Before any
+    timing every method runs once over two tiny steps, so numba's compilation (the
+    fixed-step methods run in the compiled kernels) is not counted; the time of a run is
+    the best of ``repeat`` (``time.perf_counter``), the least disturbed by other work.
+    The fixed-step methods run in the compiled kernels and ``rkmk45`` in Python, so their
+    times compare implementations as well as methods; the step counts compare the methods.
+
+    Parameters
+    ----------
+    body : RigidBody
+        The body, free of loads.
+    t_end : float
+        End time (s), > 0.
+    methods : sequence of str
+        Names from :data:`tumble.rigid.METHODS`.
+    omega0 : array_like, shape (3,)
+        Initial body angular velocity (rad/s).
+    steps : sequence of int
+        Step counts of the fixed-step methods.
+    tolerances : sequence of float
+        Tolerances of the adaptive methods.
+    repeat : int
+        Timed runs per point.
+
+    Returns
+    -------
+    list of WorkPrecisionPoint
+        In the order of ``methods``, then of ``steps`` or ``tolerances``.
+
+    Raises
+    ------
+    ValueError
+        Empty or unknown ``methods``; empty or non-positive ``steps`` or ``tolerances``
+        where a method needs them; ``t_end`` or ``repeat`` not positive.
+
+    Examples
+    --------
+    >>> body = RigidBody(1.0, [2.0, 1.0, 2.0 / 3.0], allow_unphysical=True)
+    >>> points = work_precision(body, 1.0, ["rkmk4"], omega0=(0.2, 0.0, 1.3),
+    ...                         steps=(10, 20), repeat=1)
+    >>> [point.steps for point in points], bool(points[0].error > points[1].error)
+    ([10, 20], True)
+    """
+    specs, t_end, repeat = _check(methods, t_end, repeat)
+    exact = free_body_rotation(body.inertia, omega0, t_end)
+    for spec in specs:  # warm-up: compile the kernels before any timing
+        options = {"rtol": 1e-3} if spec.adaptive else {"h": 1e-3}
+        simulate(body, 2e-3, method=spec.name, omega0=omega0, **options)
+    points = []
+    for spec in specs:
+        if spec.adaptive:
+            settings = _positive_values("tolerances", tolerances, float)
+            runs = [{"rtol": tol, "atol": tol} for tol in settings]
+        else:
+            settings = [t_end / n for n in _positive_values("steps", steps, int)]
+            runs = [{"h": h} for h in settings]
+        for setting, options in zip(settings, runs, strict=True):
+            seconds, run = _timed(repeat, body, t_end, spec.name, omega0, options)
+            error = float(np.linalg.norm(run.R[-1] - exact)) if run.status == 0 else np.inf
+            points.append(
+                WorkPrecisionPoint(spec.name, setting, run.n_steps, run.n_rejected, seconds, error)
+            )
+    return points
+
+
+def _timed(repeat: int, body, t_end, method, omega0, options):
+    """Best wall time of ``repeat`` runs, and the last run's trajectory."""
+    best = np.inf
+    for _ in range(repeat):
+        start = time.perf_counter()
+        run = simulate(
+            body, t_end, method=method, omega0=omega0, record_every=_KEEP_ENDS, **options
+        )
+        best = min(best, time.perf_counter() - start)
+    return best, run
+
+
+def _check(methods, t_end, repeat):
+    methods = (methods,) if isinstance(methods, str) else tuple(methods)
+    if not methods:
+        raise ValueError("methods=() is empty: name at least one of tumble.rigid.METHODS")
+    specs = [get_method(name) for name in methods]
+    if not (isinstance(t_end, int | float) and np.isfinite(t_end) and t_end > 0):
+        raise ValueError(f"t_end={t_end!r} must be a finite time > 0 (s)")
+    if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < 1:
+        raise ValueError(f"repeat={repeat!r} must be an integer ≥ 1")
+    return specs, float(t_end), repeat
+
+
+def _positive_values(name: str, values, kind) -> list:
+    values = list(values)
+    good = all(
+        isinstance(v, int | float | np.number) and not isinstance(v, bool) and v > 0
+        for v in values
+    )
+    if not values or not good or (kind is int and any(int(v) != v for v in values)):
+        what = "positive integers" if kind is int else "positive numbers"
+        raise ValueError(f"{name}={tuple(values)!r} must be a non-empty sequence of {what}")
+    return [kind(v) for v in values]
+
+
+def table(points: Sequence[WorkPrecisionPoint]) -> list[dict]:
+    """One dict per point, for printing: the fields plus ``setting_name`` (``h`` or ``rtol``).
+
+    Examples
+    --------
+    >>> table([WorkPrecisionPoint("rkmk4", 0.1, 10, 0, 0.002, 3e-7)])[0]["setting_name"]
+    'h'
+    """
+    return [{**asdict(point), "setting_name": point.setting_name} for point in points]
