@@ -11,6 +11,7 @@ beam every 10 steps of the midpoint run as frames for an animation.
 
 from __future__ import annotations
 
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -65,7 +66,8 @@ def run(
     ScenarioResult
         ``summary``: frequencies and errors, Δt, the critical step, per-scheme energy
         and tip results, the sweep; ``data``: the system, the runs, the sweeps and the
-        frames; ``figures``: energy per scheme, the sweep, the beam shapes.
+        frames; ``figures``: energy per scheme, the sweep, the beam shapes; one dataset per
+        scheme; ``animation.gif``: the midpoint run's beam, at most :data:`MAX_FRAMES` frames.
     """
     for name, value in (
         ("steps_per_period", steps_per_period),
@@ -104,7 +106,18 @@ def run(
         figures=_figures(beam, runs, sweeps, scale, frame_every),
         datasets={scheme: _dataset(response) for scheme, response in runs.items()},
         attrs={**settings, "dt": dt, "schemes": list(runs)},
+        animations=[("animation.gif", partial(_animate, beam, midpoint, frame_every))],
     )
+
+
+MAX_FRAMES = 100
+"""At most this many frames in ``animation.gif`` (``frame_every`` is raised to keep it so)."""
+
+
+def _animate(beam, response, frame_every: int, path) -> None:
+    every = max(frame_every, -(-len(response.t) // MAX_FRAMES))
+    title = f"{NAME} — tip-loaded cantilever, every {every} steps"
+    viz.beam_animation(beam, response, path, every=every, title=title)
 
 
 def _dataset(response):
