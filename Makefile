@@ -8,7 +8,7 @@ BENCH_STAMP := $(VENV)/.installed-bench
 DEMO ?= t-handle
 RUN_DIR ?= runs/$(DEMO)
 
-.PHONY: demo test bench lint format clean
+.PHONY: demo test browser bench lint format clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -25,12 +25,18 @@ $(BENCH_STAMP): pyproject.toml $(STAMP)
 demo: $(STAMP)
 	$(BIN)/tumble run $(DEMO) --out $(RUN_DIR) --force
 
-test: $(STAMP)
+# tests/viz/test_viz_browser.py loads view.html in a real headless Chromium (Debian's packages).
+test: $(STAMP) browser
 	$(BIN)/python -m pytest
+
+browser:
+	@command -v chromium >/dev/null && command -v chromedriver >/dev/null \
+		|| (apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
+		apt-get install -y -q --no-install-recommends chromium chromium-driver)
 
 # OpenSeesPy (the beam peer) imports only with Debian's BLAS/LAPACK; install them when we can.
 bench: $(BENCH_STAMP)
-	@dpkg -s libblas3 liblapack3 >/dev/null 2>&1 || apt-get install -y -q libblas3 liblapack3 \
+	@dpkg -s libblas3 liblapack3 >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -q libblas3 liblapack3) \
 		|| echo "note: libblas3/liblapack3 missing; the OpenSees columns will be skipped"
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/run_all.py
 

@@ -1,0 +1,142 @@
+"""view.html in a real browser: headless Chromium (Debian's ``chromium``, ``chromium-driver``).
+
+``make test`` installs both packages when they are missing. Without them these tests fail
+(they are not skipped): the viewer is only known to work once a browser has drawn it.
+
+WebGL runs on SwiftShader (software); ``--enable-unsafe-swiftshader`` opts in to it, so
+Chromium logs no deprecation warning for the automatic fallback.
+"""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import tumble
+from tumble import meshes
+from tumble.viz.html import DIV_ID, html_viewer, viewer_figure
+
+CHROMIUM = Path("/usr/bin/chromium")
+CHROMEDRIVER = Path("/usr/bin/chromedriver")
+FLAGS = (
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--enable-unsafe-swiftshader",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--window-size=1280,1000",
+)
+WAIT_S = 20
+FRAMES = 20
+PLOT = f"document.getElementById('{DIV_ID}')"
+DRAWN_SCENE = f"""
+const div = {PLOT};
+return Boolean(div && div.classList.contains('js-plotly-plot') && div._fullLayout
+    && div._fullLayout.scene && div._fullLayout.scene._scene
+    && div._fullLayout.scene._scene.glplot
+    && div.querySelector('.gl-container canvas'));
+"""
+SLIDER_STATE = f"""
+const div = {PLOT};
+return [div._fullLayout.sliders[0].active, Array.from(div._fullData[0].x)];
+"""
+
+
+@pytest.fixture(scope="module")
+def view(tmp_path_factory):
+    """view.html of a 5 s T-handle run (h = 0.01 s, 20 frames) and the figure it draws."""
+    body = tumble.rigid.RigidBody.from_mass_properties(tumble.mass.t_handle())
+    run = tumble.rigid.simulate(body, 5.0, h=0.01, omega0=(0.0, 5.0, 0.1))
+    path = tmp_path_factory.mktemp("view") / "view.html"
+    html_viewer(run, meshes.t_handle(16), path, title="T-handle", frames=FRAMES)
+    return path, viewer_figure(run, meshes.t_handle(16), title="T-handle", frames=FRAMES)
+
+
+@pytest.fixture(scope="module")
+def browser(tmp_path_factory):
+    """Headless Chromium through Debian's chromedriver; never downloads a driver."""
+    missing = [str(path) for path in (CHROMIUM, CHROMEDRIVER) if not path.exists()]
+    if missing:
+        pytest.fail(
+            f"{', '.join(missing)} not found: the browser test needs Debian's chromium and "
+            "chromium-driver; run `make test` (it installs them) or "
+            "`apt-get install chromium chromium-driver`",
+            pytrace=False,
+        )
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+
+    options = webdriver.ChromeOptions()
+    options.binary_location = str(CHROMIUM)
+    for flag in (*FLAGS, f"--user-data-dir={tmp_path_factory.mktemp('chromium-profile')}"):
+        options.add_argument(flag)
+    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    service = Service(executable_path=str(CHROMEDRIVER))
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("SE_OFFLINE", "true")  # selenium-manager must not look for a driver online
+        driver = webdriver.Chrome(service=service, options=options)
+    try:
+        yield driver
+    finally:
+        driver.quit()
+
+
+@pytest.fixture
+def page(browser, view):
+    """The browser with view.html loaded and its 3D scene drawn (WebGL context live)."""
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    browser.get_log("browser")  # drop the previous page's messages
+    browser.get(view[0].as_uri())
+    WebDriverWait(browser, WAIT_S).until(
+        lambda driver: driver.execute_script(DRAWN_SCENE),
+        message=f"the 3D scene of {view[0].name} was not drawn within {WAIT_S} s",
+    )
+    return browser
+
+
+def severe_messages(driver) -> list[str]:
+    """The console's SEVERE entries since the last call (warnings, e.g. GPU stalls, pass)."""
+    return [entry["message"] for entry in driver.get_log("browser") if entry["level"] == "SEVERE"]
+
+
+def test_view_loads_with_a_webgl_scene_and_no_console_errors(page):
+    """The plot, its 3D scene with a live WebGL context and a canvas appear (the ``page``
+    fixture waits for them); the console holds no SEVERE entry; the mesh is the first trace."""
+    assert severe_messages(page) == []
+    assert page.execute_script(f"return {PLOT}._fullLayout.scene.xaxis.title.text") == "x (m)"
+    assert page.execute_script(f"return {PLOT}._fullData[0].type") == "mesh3d"
+
+
+def test_clicking_the_slider_rail_moves_the_mesh(page, view):
+    """Drive the real slider UI: a click on its rail at 70 % of its width.
+
+    The slider's active step must change to about 70 % of the frames, and the drawn mesh's
+    vertices (``_fullData[0].x``) must change to exactly that frame's vertices.
+    """
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.by import By
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    active, before = page.execute_script(SLIDER_STATE)
+    assert active == 0
+    rail = page.find_element(By.CSS_SELECTOR, f"#{DIV_ID} .slider-rail-touch-rect")
+    offset = round(0.2 * rail.size["width"])  # from the rail's centre: 70 % along
+    ActionChains(page).move_to_element_with_offset(rail, offset, 0).click().perform()
+    WebDriverWait(page, WAIT_S).until(
+        lambda driver: driver.execute_script(SLIDER_STATE)[0] != 0,
+        message=f"the slider did not move within {WAIT_S} s of a click on its rail",
+    )
+    WebDriverWait(page, WAIT_S).until(
+        lambda driver: driver.execute_script(SLIDER_STATE)[1] != before,
+        message=f"the mesh was not redrawn within {WAIT_S} s of moving the slider",
+    )
+    active, after = page.execute_script(SLIDER_STATE)
+    assert abs(active - 0.7 * (FRAMES - 1)) <= 1.5
+    expected = np.asarray(view[1].frames[active].data[0].x, dtype=float)
+    np.testing.assert_allclose(after, expected, rtol=1e-6)
+    assert severe_messages(page) == []
