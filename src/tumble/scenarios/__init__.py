@@ -19,6 +19,7 @@ _MODULES = {
     "t-handle": "tumble.scenarios.t_handle",
     "convergence": "tumble.scenarios.convergence",
     "beam": "tumble.scenarios.beam",
+    "rigid-body": "tumble.scenarios.rigid_body",
 }
 
 

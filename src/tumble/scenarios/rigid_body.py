@@ -1,0 +1,645 @@
+"""The user's own rigid body: a primitive, a composite or a mesh, with loads, by any method.
+
+A scenario file with ``scenario = "rigid-body"`` runs this. Its options are checked by the
+pydantic model :data:`OPTIONS`, the same whether they come from a file or from Python. The
+body is described in its own coordinates (m):
+
+* a primitive: ``{"shape": "cylinder", "radius": 0.01, "length": 0.08, "axis": "y",
+  "center": [-0.01, 0, 0], "density": 6700}``, with shapes ``cylinder``, ``box``,
+  ``sphere``, ``torus`` and ``hex_prism`` (:mod:`tumble.mass`, :mod:`tumble.meshes`);
+* a composite: ``{"density": 6700, "parts": [...]}``, primitives or meshes added by the
+  parallel-axis theorem (a part with neither ``density`` nor ``mass`` takes the
+  composite's ``density``);
+* a mesh file: ``{"mesh": "part.stl", "density": 2700, "scale": 0.001}``
+  (:func:`tumble.mass.from_mesh`; the mesh must be closed and outward-oriented).
+
+The simulated body has its centre of mass ``com`` at the origin and keeps the axes of the
+description (its inertia need not be diagonal). At ``t = 0`` the body stands where the
+description puts it: ``x0`` defaults to ``com`` and the attitude to the identity.
+
+Loads are constant: ``gravity`` (``g`` in m/s²); ``force`` (``force`` in N, world frame, at
+a ``point`` fixed on the body, in the description's coordinates; default the centre of
+mass); ``torque`` (N m, world frame); ``impulse`` (``impulse`` in N s at the world
+``point`` at ``time``).
+"""
+
+from __future__ import annotations
+
+from functools import partial
+from pathlib import Path
+from typing import Annotated, Any, ClassVar, Literal, Union
+
+import numpy as np
+import trimesh
+from pydantic import (
+    AfterValidator,
+    Discriminator,
+    Field,
+    Tag,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
+
+from tumble import mass, meshes, so3
+from tumble.rigid import Force, Gravity, Impulse, RigidBody, Torque, Trajectory, simulate
+from tumble.rigid.initial import check_steps, initial_attitude
+from tumble.rigid.methods import METHODS, get_method
+from tumble.scenarios._base import ScenarioResult, rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios.files import (
+    Matrix3,
+    NonNegative,
+    Positive,
+    PositiveInteger,
+    Section,
+    Text,
+    Vector3,
+    Vector4,
+    custom_error,
+    one_of,
+    validate,
+)
+from tumble.viz import rigid
+
+NAME = "rigid-body"
+SUMMARY = "Your own body (primitive, composite or mesh file) with loads, from a scenario file."
+
+
+def _checked(build):
+    """``build()``; a ValueError from the library becomes an error of the whole table."""
+    try:
+        return build()
+    except ValueError as error:
+        raise custom_error("whole_invalid", "{reason}", reason=str(error)) from None
+
+
+def _axis(value: Any) -> str | list[float]:
+    if isinstance(value, str) and value in mass.AXES:
+        return value
+    if not isinstance(value, str | bool):
+        try:
+            mass.axis_vector(value)
+            return np.asarray(value, dtype=float).tolist()
+        except (TypeError, ValueError):
+            pass
+    raise custom_error("axis", 'must be "x", "y", "z" or a nonzero vector of 3 numbers')
+
+
+Axis = Annotated[Any, AfterValidator(_axis)]
+"""``"x"``, ``"y"``, ``"z"`` or a nonzero 3-vector."""
+
+# --- bodies ------------------------------------------------------------------------------
+
+
+class _Solid(Section):
+    """A primitive of :mod:`tumble.mass` and :mod:`tumble.meshes`, named by ``shape``.
+
+    Each primitive lists its ``dimensions`` (passed first, in order) and its ``placement``
+    keys; both modules take the same arguments, plus ``density`` (kg/m³) or ``mass`` (kg)
+    for the mass properties.
+    """
+
+    dimensions: ClassVar[tuple[str, ...]] = ()
+    placement: ClassVar[tuple[str, ...]] = ("axis", "center")
+    density: Positive | None = None
+    mass: Positive | None = None
+    center: Vector3 = [0.0, 0.0, 0.0]
+
+    @model_validator(mode="after")
+    def _consistent(self) -> _Solid:
+        if (self.density is None) == (self.mass is None):
+            given = "both" if self.density is not None else "neither"
+            raise custom_error(
+                "whole_amount",
+                "a {shape} needs exactly one of density (kg/m³) or mass (kg); got {given}",
+                shape=self.shape,
+                given=given,
+            )
+        _checked(self.mass_properties)
+        return self
+
+    def _arguments(self) -> tuple[list, dict[str, Any]]:
+        sizes = [getattr(self, name) for name in self.dimensions]
+        return sizes, {name: getattr(self, name) for name in self.placement}
+
+    def mass_properties(self) -> mass.MassProperties:
+        """Mass, centre of mass (m) and inertia (kg m²) in the description's coordinates."""
+        sizes, placement = self._arguments()
+        build = getattr(mass, self.shape)
+        return build(*sizes, density=self.density, mass=self.mass, **placement)
+
+    def surface(self) -> trimesh.Trimesh:
+        """The closed triangle mesh, in the description's coordinates."""
+        sizes, placement = self._arguments()
+        return getattr(meshes, self.shape)(*sizes, **placement)
+
+    def label(self) -> str:
+        return self.shape
+
+
+class Cylinder(_Solid):
+    """A solid circular cylinder: ``radius`` and ``length`` (m) along ``axis``."""
+
+    what: ClassVar[str] = "a key of a cylinder"
+    dimensions: ClassVar[tuple[str, ...]] = ("radius", "length")
+    shape: Literal["cylinder"]
+    radius: Positive
+    length: Positive
+    axis: Axis = "z"
+
+
+class HexPrism(_Solid):
+    """A regular hexagonal prism: ``circumradius`` (= side) and ``length`` (m) along ``axis``."""
+
+    what: ClassVar[str] = "a key of a hex_prism"
+    dimensions: ClassVar[tuple[str, ...]] = ("circumradius", "length")
+    shape: Literal["hex_prism"]
+    circumradius: Positive
+    length: Positive
+    axis: Axis = "z"
+
+
+class Torus(_Solid):
+    """A ring torus: ``major_radius`` and ``minor_radius`` (m); ``axis`` through the hole."""
+
+    what: ClassVar[str] = "a key of a torus"
+    dimensions: ClassVar[tuple[str, ...]] = ("major_radius", "minor_radius")
+    shape: Literal["torus"]
+    major_radius: Positive
+    minor_radius: Positive
+    axis: Axis = "z"
+
+
+class Sphere(_Solid):
+    """A solid sphere of ``radius`` (m)."""
+
+    what: ClassVar[str] = "a key of a sphere"
+    dimensions: ClassVar[tuple[str, ...]] = ("radius",)
+    placement: ClassVar[tuple[str, ...]] = ("center",)
+    shape: Literal["sphere"]
+    radius: Positive
+
+
+class Box(_Solid):
+    """A box of edge lengths ``extents`` (m), turned by ``rotation`` (3×3, body to world)."""
+
+    what: ClassVar[str] = "a key of a box"
+    dimensions: ClassVar[tuple[str, ...]] = ("extents",)
+    placement: ClassVar[tuple[str, ...]] = ("rotation", "center")
+    shape: Literal["box"]
+    extents: Vector3
+    rotation: Matrix3 | None = None
+
+
+Primitive = Annotated[Cylinder | Box | Sphere | Torus | HexPrism, Field(discriminator="shape")]
+
+
+class MeshBody(Section):
+    """A closed triangle mesh file of uniform ``density``; its coordinates times ``scale``."""
+
+    what: ClassVar[str] = "a key of a mesh body"
+    mesh: Text
+    density: Positive
+    scale: Positive = 1.0
+
+    @field_validator("mesh")
+    @classmethod
+    def _solid_file(cls, value: str, info: ValidationInfo) -> str:
+        """Resolve ``mesh`` against the file's folder; it must be a closed, outward mesh."""
+        folder = (info.context or {}).get("folder") or Path.cwd()
+        path = (Path(folder) / value).resolve()
+        if not path.is_file():
+            raise custom_error("file", "no such file (looked for {path})", path=str(path))
+        try:
+            surface = meshes.validate_solid(meshes.load(path), name="the mesh")
+        except ValueError as error:
+            raise custom_error("mesh", "{reason}", reason=str(error)) from None
+        if surface.volume < 0:
+            raise custom_error(
+                "inside_out",
+                "the mesh is inside-out (negative volume); flip its faces (trimesh: "
+                "mesh.invert()) and save it again",
+            )
+        return str(path)
+
+    @model_validator(mode="after")
+    def _consistent(self) -> MeshBody:
+        _checked(self.mass_properties)
+        return self
+
+    def surface(self) -> trimesh.Trimesh:
+        return meshes.load(self.mesh).apply_scale(self.scale)
+
+    def mass_properties(self) -> mass.MassProperties:
+        return mass.from_mesh(self.surface(), density=self.density)
+
+    def label(self) -> str:
+        return f"mesh {Path(self.mesh).name}"
+
+
+_KEYS = {"shape": "<primitive>", "mesh": "<mesh>", "parts": "<composite>"}
+"""A body's kind, by the key that says it (the tags stay out of error messages)."""
+
+
+def _kind(value: Any) -> str | None:
+    if isinstance(value, dict):
+        return next((tag for key, tag in _KEYS.items() if key in value), None)
+    if isinstance(value, MeshBody | Composite):
+        return _KEYS["mesh" if isinstance(value, MeshBody) else "parts"]
+    return _KEYS["shape"] if isinstance(value, _Solid) else None
+
+
+def _union(members: dict[str, Any], message: str) -> Any:
+    tagged = tuple(Annotated[kind, Tag(tag)] for tag, kind in members.items())
+    return Annotated[
+        Union[tagged],  # noqa: UP007 - built from a tuple
+        Discriminator(_kind, custom_error_type="whole_kind", custom_error_message=message),
+    ]
+
+
+Part = _union(
+    {"<primitive>": Primitive, "<mesh>": MeshBody},
+    "each part needs a shape (cylinder, box, sphere, torus, hex_prism) or a mesh file",
+)
+
+
+class Composite(Section):
+    """Parts added by the parallel-axis theorem; ``density`` is the default of each part."""
+
+    what: ClassVar[str] = "a key of a composite body"
+    parts: Annotated[list[Part], Field(min_length=1)]
+    density: Positive | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _share_density(cls, data: Any) -> Any:
+        if isinstance(data, dict) and "density" in data and isinstance(data.get("parts"), list):
+            parts = [
+                {**part, "density": data["density"]}
+                if isinstance(part, dict) and not {"density", "mass"} & set(part)
+                else part
+                for part in data["parts"]
+            ]
+            data = {**data, "parts": parts}
+        return data
+
+    def mass_properties(self) -> mass.MassProperties:
+        return sum(part.mass_properties() for part in self.parts)
+
+    def surface(self) -> trimesh.Trimesh:
+        return trimesh.util.concatenate([part.surface() for part in self.parts])
+
+    def label(self) -> str:
+        return "composite (" + " + ".join(part.label() for part in self.parts) + ")"
+
+
+Body = _union(
+    {"<primitive>": Primitive, "<mesh>": MeshBody, "<composite>": Composite},
+    "the body needs shape (a primitive), parts (a composite) or mesh (a mesh file)",
+)
+
+# --- initial state and loads ---------------------------------------------------------------
+
+
+class Initial(Section):
+    """``x0`` (m), ``v0`` (m/s); attitude ``R0``, ``q0`` or ``euler_zyx`` (rad); ``omega0``
+    (rad/s, body) or ``L0`` (kg m²/s, world)."""
+
+    what: ClassVar[str] = "a key of [options.initial]"
+    x0: Vector3 | None = None
+    v0: Vector3 | None = None
+    R0: Matrix3 | None = None
+    q0: Vector4 | None = None
+    euler_zyx: Vector3 | None = None
+    omega0: Vector3 | None = None
+    L0: Vector3 | None = None
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Initial:
+        for group in (("R0", "q0", "euler_zyx"), ("omega0", "L0")):
+            given = [name for name in group if getattr(self, name) is not None]
+            if len(given) > 1:
+                raise custom_error(
+                    "whole_exclusive",
+                    "give at most one of {group} (they set the same thing); got {given}",
+                    group=", ".join(group),
+                    given=" and ".join(given),
+                )
+        _checked(self.attitude)
+        return self
+
+    def attitude(self) -> np.ndarray:
+        """The initial rotation matrix (body to world)."""
+        if self.euler_zyx is not None:
+            return so3.matrix_from_euler_zyx(self.euler_zyx)
+        return initial_attitude(self.R0, self.q0)
+
+
+class GravityLoad(Section):
+    """Uniform gravity ``g`` (m/s², world)."""
+
+    what: ClassVar[str] = "a key of a gravity load"
+    type: Literal["gravity"]
+    g: Vector3 = [0.0, 0.0, -9.81]
+
+    def build(self, com: np.ndarray) -> Gravity:
+        return Gravity(self.g)
+
+
+class ForceLoad(Section):
+    """A constant world force (N) at a body point (the description's coordinates, m)."""
+
+    what: ClassVar[str] = "a key of a force load"
+    type: Literal["force"]
+    force: Vector3
+    point: Vector3 | None = None
+
+    def build(self, com: np.ndarray) -> Force:
+        return Force(self.force, None if self.point is None else np.subtract(self.point, com))
+
+
+class TorqueLoad(Section):
+    """A constant world torque (N m) about the centre of mass."""
+
+    what: ClassVar[str] = "a key of a torque load"
+    type: Literal["torque"]
+    torque: Vector3
+
+    def build(self, com: np.ndarray) -> Torque:
+        return Torque(self.torque)
+
+
+class ImpulseLoad(Section):
+    """A kick ``impulse`` (N s, world) at the world ``point`` (m) at ``time`` (s)."""
+
+    what: ClassVar[str] = "a key of an impulse load"
+    type: Literal["impulse"]
+    impulse: Vector3
+    point: Vector3
+    time: NonNegative = 0.0
+
+    def build(self, com: np.ndarray) -> Impulse:
+        return Impulse(point=self.point, impulse=self.impulse, time=self.time)
+
+
+Load = Annotated[GravityLoad | ForceLoad | TorqueLoad | ImpulseLoad, Field(discriminator="type")]
+
+
+class Options(Section):
+    """The options of :func:`run`; defaults as there."""
+
+    what: ClassVar[str] = f"an option of scenario {NAME!r}"
+    body: Body
+    initial: Initial = Initial()
+    loads: list[Load] = []
+    method: Annotated[Text, AfterValidator(one_of(list(METHODS)))] = "rkmk4"
+    h: Positive | None = 0.01
+    rtol: Positive | None = None
+    atol: NonNegative | None = None
+    t_end: Positive = 10.0
+    record_every: PositiveInteger = 1
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Options:
+        _checked(lambda: check_steps(get_method(self.method), self.h, self.rtol, self.atol))
+        for index, load in enumerate(self.loads):
+            if isinstance(load, ImpulseLoad) and load.time > self.t_end:
+                raise custom_error(
+                    "whole_late",
+                    "loads[{index}].time = {time} is after t_end = {t_end}; the impulse "
+                    "would never act",
+                    index=index,
+                    time=load.time,
+                    t_end=self.t_end,
+                )
+        return self
+
+
+OPTIONS = Options
+"""The options model :func:`tumble.scenarios.files.check_options` uses for this scenario."""
+
+# --- the run ---------------------------------------------------------------------------------
+
+
+def run(
+    *,
+    body: dict[str, Any],
+    initial: dict[str, Any] | None = None,
+    loads: list[dict[str, Any]] | tuple = (),
+    method: str = "rkmk4",
+    h: float | None = 0.01,
+    rtol: float | None = None,
+    atol: float | None = None,
+    t_end: float = 10.0,
+    record_every: int = 1,
+) -> ScenarioResult:
+    """Simulate the described body from ``t = 0`` to ``t_end``.
+
+    Parameters
+    ----------
+    body : dict
+        A primitive, a composite or a mesh file (module docstring; keys with units in
+        ``docs/scenario-files.md``).
+    initial : dict, optional
+        ``x0`` (m; default the centre of mass), ``v0`` (m/s), one of ``R0`` (3×3), ``q0``
+        (``[w, x, y, z]``) or ``euler_zyx`` (``[φ_z, θ_y, ψ_x]``, rad), one of ``omega0``
+        (rad/s, body frame) or ``L0`` (kg m²/s, world frame).
+    loads : list of dict
+        Each with ``type`` ``"gravity"``, ``"force"``, ``"torque"`` or ``"impulse"``.
+    method : str
+        A :data:`tumble.rigid.METHODS` name.
+    h : float or None
+        Step (s); the first step for ``rkmk45``.
+    rtol, atol : float, optional
+        Tolerances of ``rkmk45``.
+    t_end : float
+        End time (s).
+    record_every : int
+        Keep every k-th step (and the last).
+
+    Returns
+    -------
+    ScenarioResult
+        ``summary``: ``body`` (what it is), ``mass`` (kg), ``com`` (m, description's
+        coordinates), ``inertia`` (kg m², about the centre of mass, body axes),
+        ``principal_moments``, the settings, ``status``/``message``, ``n_steps``, the
+        ``final`` state (``t``, ``x``, ``v``, ``R``, ``q``, ``omega_body``, ``L_world``,
+        ``energy``), ``energy_drift`` (largest ``|E − E₀|/E₀``), ``momentum_drift``
+        (largest ``|L − L₀|/|L₀|``; each None when its reference is zero),
+        ``max_orthogonality_error`` and ``conserved`` (whether the loads leave energy and
+        angular momentum constant, so the drifts measure the method's error). Figures
+        ``rotation_grid.png``, ``euler_angles.png``, ``angular_velocity.png``,
+        ``drift.png``, ``snapshots.png``; the trajectory and the mesh as datasets;
+        ``animation.gif`` and ``view.html``.
+
+    Raises
+    ------
+    ValueError
+        Naming the key path (``body.parts[1].radius``), the bad value and what is allowed.
+
+    Examples
+    --------
+    A sphere spun about z turns at constant rate (no loads):
+
+    >>> result = run(body={"shape": "sphere", "radius": 0.1, "density": 1000.0},
+    ...              initial={"omega0": [0.0, 0.0, 2.0]}, t_end=1.0, h=0.1)
+    >>> round(result.summary["final"]["omega_body"][2], 12), result.summary["conserved"]
+    (2.0, {'energy': True, 'angular_momentum': True})
+    """
+    given = {
+        "body": body,
+        "initial": {} if initial is None else initial,
+        "loads": list(loads),
+        "method": method,
+        "h": h,
+        "rtol": rtol,
+        "atol": atol,
+        "t_end": t_end,
+        "record_every": record_every,
+    }
+    options = validate(Options, given)
+    properties = options.body.mass_properties()
+    rigid_body = RigidBody.from_mass_properties(properties)
+    com = np.asarray(properties.com)
+    surface = options.body.surface().apply_translation(-com)
+    forces = [load.build(com) for load in options.loads]
+    start = options.initial
+    trajectory = simulate(
+        rigid_body,
+        options.t_end,
+        method=options.method,
+        h=options.h,
+        rtol=options.rtol,
+        atol=options.atol,
+        x0=com if start.x0 is None else start.x0,
+        v0=start.v0,
+        R0=start.attitude(),
+        omega0=start.omega0,
+        L0=start.L0,
+        forces=forces,
+        record_every=options.record_every,
+    )
+    summary = _summary(options, properties, trajectory, forces)
+    title = f"{NAME}: {options.body.label()} — {_setting(options)}"
+    return ScenarioResult(
+        name=NAME,
+        summary=summary,
+        data={"trajectory": trajectory, "body": rigid_body, "mesh": surface, "options": options},
+        figures=_figures(trajectory, surface, title, summary["conserved"]),
+        datasets=rigid_datasets({options.method: trajectory}, surface, options.method),
+        attrs=rigid_attrs(
+            rigid_body,
+            method=options.method,
+            h=options.h,
+            rtol=options.rtol,
+            atol=options.atol,
+            t_end=options.t_end,
+            body_kind=options.body.label(),
+            com=com.tolist(),
+        ),
+        animations=rigid_animations(trajectory, surface, title=title, loads=tuple(forces)),
+    )
+
+
+def _setting(options: Options) -> str:
+    if get_method(options.method).adaptive:
+        return f"{options.method}, rtol = {options.rtol or 1e-6:g}"
+    return f"{options.method}, h = {options.h:g} s"
+
+
+def _conserved(forces: list) -> dict[str, bool]:
+    """Whether energy and angular momentum stay constant under ``forces`` after ``t = 0``."""
+    late_kick = any(isinstance(load, Impulse) and load.time > 0 for load in forces)
+    continuous = [load for load in forces if not isinstance(load, Impulse)]
+    turning = [
+        load
+        for load in continuous
+        if isinstance(load, Torque) or (isinstance(load, Force) and load.point is not None)
+    ]
+    return {
+        "energy": not (continuous or late_kick),
+        "angular_momentum": not (turning or late_kick),
+    }
+
+
+def _relative_drift(values: np.ndarray) -> float | None:
+    """Largest ``|v − v₀| / |v₀|`` over the run (norms for vectors); None if ``v₀ = 0``."""
+    values = values.reshape(len(values), -1)
+    scale = float(np.linalg.norm(values[0]))
+    if scale == 0.0 or not np.isfinite(scale):
+        return None
+    with np.errstate(all="ignore"):
+        return float(np.max(np.linalg.norm(values - values[0], axis=1)) / scale)
+
+
+def _summary(options: Options, properties, trajectory: Trajectory, forces: list) -> dict:
+    moments, _ = properties.principal()
+    final = {
+        "t": float(trajectory.t[-1]),
+        "x": trajectory.x[-1].tolist(),
+        "v": trajectory.v[-1].tolist(),
+        "R": trajectory.R[-1].tolist(),
+        "q": trajectory.q[-1].tolist(),
+        "omega_body": trajectory.omega_body[-1].tolist(),
+        "L_world": trajectory.L_world[-1].tolist(),
+        "energy": float(trajectory.energy[-1]),
+    }
+    return {
+        "scenario": NAME,
+        "body": options.body.label(),
+        "mass": float(properties.mass),
+        "com": np.asarray(properties.com).tolist(),
+        "inertia": np.asarray(properties.inertia).tolist(),
+        "principal_moments": moments.tolist(),
+        "loads": [load.type for load in options.loads],
+        "method": options.method,
+        "h": options.h,
+        "rtol": options.rtol,
+        "atol": options.atol,
+        "t_end": options.t_end,
+        "status": trajectory.status,
+        "message": trajectory.message,
+        "n_steps": trajectory.n_steps,
+        "final": final,
+        "energy_drift": _relative_drift(trajectory.energy),
+        "momentum_drift": _relative_drift(trajectory.L_world),
+        "max_orthogonality_error": float(np.max(trajectory.orthogonality_error)),
+        "conserved": _conserved(forces),
+    }
+
+
+def _figures(trajectory: Trajectory, surface, title: str, conserved: dict[str, bool]) -> list:
+    label, t = trajectory.method, trajectory.t
+    changing = [name.replace("_", " ") for name, kept in conserved.items() if not kept]
+    note = f"\n(the loads change the {' and '.join(changing)})" if changing else ""
+    drift_title = title + note
+    omega0 = ", ".join(f"{w:.3g}" for w in trajectory.omega_body[0])
+    rates = f"{label}, ω₀ = ({omega0}) rad/s"
+    moments = sorted({0, len(t) // 2, len(t) - 1})
+    frames = [(f"t = {t[k]:g} s", trajectory.x[k], trajectory.R[k]) for k in moments]
+    return [
+        (
+            "rotation_grid.png",
+            partial(rigid.rotation_grid, [(label, t, trajectory.R)], title=title),
+        ),
+        (
+            "euler_angles.png",
+            partial(rigid.euler_angles, [(label, t, trajectory.euler_zyx())], title=title),
+        ),
+        (
+            "angular_velocity.png",
+            partial(rigid.angular_velocity, [(rates, t, trajectory.omega_body)], title=title),
+        ),
+        ("drift.png", partial(rigid.drift, [(label, trajectory)], title=drift_title)),
+        (
+            "snapshots.png",
+            partial(
+                rigid.body_snapshots,
+                np.asarray(surface.vertices),
+                np.asarray(surface.faces),
+                frames,
+                title=title,
+                trail=trajectory.x,
+            ),
+        ),
+    ]
