@@ -36,3 +36,137 @@ def test_existing_folder_exits_2_without_force(tmp_path):
     assert result.exit_code == 2
     assert "--force" in result.output
     assert (tmp_path / "keep.txt").read_text() == "mine"
+
+
+def _summary(folder):
+    return json.loads((folder / "summary.json").read_text())
+
+
+def test_run_takes_method_h_and_t_end(tmp_path):
+    out = tmp_path / "th"
+    args = ["run", "t-handle", "--out", str(out), "--method", "rk4-quat", "--h", "0.02"]
+    result = runner.invoke(app, [*args, "--t-end", "1.5", "--no-animation"])
+    assert result.exit_code == 0, result.output
+    summary = _summary(out)
+    assert (summary["method"], summary["h"], summary["t_end"]) == ("rk4-quat", 0.02, 1.5)
+    assert "animation.gif" not in summary["files"] and not (out / "view.html").exists()
+
+
+def test_an_option_the_scenario_does_not_take_exits_2_naming_it(tmp_path):
+    result = runner.invoke(app, ["run", "beam", "--h", "0.1", "--out", str(tmp_path / "b")])
+    assert result.exit_code == 2
+    assert "--h" in result.output and "beam" in result.output and "n_elements" in result.output
+
+
+def test_a_bad_value_exits_2_naming_the_key_and_value(tmp_path):
+    result = runner.invoke(app, ["run", "t-handle", "--h", "-0.01", "--out", str(tmp_path / "x")])
+    assert result.exit_code == 2
+    assert "h" in result.output and "-0.01" in result.output
+    result = runner.invoke(app, ["run", "t-handle", "--method", "rk5", "--out", str(tmp_path)])
+    assert result.exit_code == 2
+    assert "rk5" in result.output and "rkmk4" in result.output
+
+
+def test_a_bad_toml_file_exits_2_naming_the_key(tmp_path):
+    path = tmp_path / "bad.toml"
+    path.write_text('scenario = "t-handle"\n[options]\nspinz = [[1.0, 0.0, 0.0]]\n')
+    result = runner.invoke(app, ["run", str(path), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2
+    assert "spinz" in result.output
+    missing = runner.invoke(app, ["run", str(tmp_path / "nowhere.toml")])
+    assert missing.exit_code == 2 and "nowhere.toml" in missing.output
+
+
+def test_the_example_file_gives_the_same_numbers_as_the_built_in(tmp_path):
+    short = ["--t-end", "3", "--no-animation"]
+    by_name = runner.invoke(app, ["run", "t-handle", "--out", str(tmp_path / "a"), *short])
+    by_file = runner.invoke(
+        app, ["run", "examples/t-handle.toml", "--out", str(tmp_path / "b"), *short]
+    )
+    assert by_name.exit_code == 0 and by_file.exit_code == 0, by_file.output
+    assert _summary(tmp_path / "a") == _summary(tmp_path / "b")
+
+
+def test_compare_writes_a_work_precision_table_and_plot(tmp_path):
+    out = tmp_path / "cmp"
+    result = runner.invoke(
+        app,
+        ["compare", "t-handle", "--methods", "lie-euler,rkmk4", "--t-end", "1", "--out", str(out)],
+    )
+    assert result.exit_code == 0, result.output
+    summary = _summary(out)
+    assert set(summary["best"]) == {"lie-euler", "rkmk4"}
+    assert summary["best"]["rkmk4"]["error"] < summary["best"]["lie-euler"]["error"]
+    assert (out / "work_precision.png").stat().st_size > 10_000
+    assert "rkmk4" in result.output and "lie-euler" in result.output
+
+
+def test_compare_refuses_a_scenario_without_a_free_body():
+    result = runner.invoke(app, ["compare", "beam"])
+    assert result.exit_code == 2
+    assert "beam" in result.output and "t-handle" in result.output
+    result = runner.invoke(app, ["compare", "t-handle", "--methods", "rkmk4,nope"])
+    assert result.exit_code == 2 and "nope" in result.output
+
+
+def test_stability_prints_the_sweep_and_writes_its_plot(tmp_path):
+    out = tmp_path / "st"
+    result = runner.invoke(
+        app, ["stability", "--n-elements", "8", "--steps", "300", "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    stable = _summary(out)["schemes"]["semi-implicit"]["stable"]
+    factors = _summary(out)["factors"]
+    # the semi-implicit scheme is stable below 2/ω_max and not well above it
+    assert all(stable[k] for k, f in enumerate(factors) if f <= 0.9)
+    assert not any(stable[k] for k, f in enumerate(factors) if f >= 2)
+    assert (out / "stability_sweep.png").is_file()
+    assert "grows" in result.output and "stable" in result.output
+
+
+def test_view_draws_view_html_again_from_data_nc(tmp_path):
+    out = tmp_path / "run"
+    args = ["run", "t-handle", "--t-end", "1", "--no-animation", "--out", str(out)]
+    assert runner.invoke(app, args).exit_code == 0
+    assert not (out / "view.html").exists()
+    result = runner.invoke(app, ["view", str(out), "--no-open"])
+    assert result.exit_code == 0, result.output
+    page = (out / "view.html").read_text()
+    assert "plotly" in page.lower() and "t-handle" in page
+
+
+def test_view_refuses_a_run_without_a_body(tmp_path):
+    out = tmp_path / "proj"
+    assert runner.invoke(app, ["run", "projectile", "--out", str(out)]).exit_code == 0
+    result = runner.invoke(app, ["view", str(out), "--no-open"])
+    assert result.exit_code == 2 and "mesh" in result.output
+    result = runner.invoke(app, ["view", str(tmp_path / "none"), "--no-open"])
+    assert result.exit_code == 2 and "summary.json" in result.output
+
+
+def test_mass_of_a_torus_mesh(tmp_path):
+    from tumble import meshes
+
+    mesh = meshes.torus(1.0, 0.5, 64, minor_sections=32)
+    path = meshes.save(mesh, tmp_path / "torus.stl")
+    result = runner.invoke(app, ["mass", str(path), "--density", "2"])
+    assert result.exit_code == 0, result.output
+    mass = float(result.output.split(" kg ")[1].split()[0])
+    assert abs(mass / (2 * mesh.volume) - 1) < 1e-5  # printed to 6 digits
+    assert abs(mass / (2 * 4.934802) - 1) < 0.01  # 2π²Rr² ρ; the polyhedron is a little smaller
+
+
+def test_mass_rejects_bad_density_and_missing_files(tmp_path):
+    from tumble import meshes
+
+    path = meshes.save(meshes.box((1.0, 2.0, 3.0)), tmp_path / "box.stl")
+    result = runner.invoke(app, ["mass", str(path), "--density", "-1"])
+    assert result.exit_code == 2 and "density" in result.output and "-1" in result.output
+    result = runner.invoke(app, ["mass", str(tmp_path / "no.stl"), "--density", "1"])
+    assert result.exit_code == 2 and "no.stl" in result.output
+
+
+def test_every_command_has_help():
+    for command in ("list", "run", "compare", "stability", "view", "mass"):
+        result = runner.invoke(app, [command, "--help"])
+        assert result.exit_code == 0 and "Usage" in result.output

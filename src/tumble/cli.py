@@ -1,17 +1,27 @@
-"""The ``tumble`` command: parse, call the library, report. Nothing else lives here."""
+"""The ``tumble`` command: parse, call the library, report. Nothing else lives here.
+
+Every command exits with 0 on success and 2 on bad input, printing a message that names the
+option or key, the bad value and what is allowed (the library's ``ValueError``).
+"""
 
 from __future__ import annotations
 
+import inspect
 import json
+import webbrowser
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.console import Console
+from rich.progress import BarColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from tumble import scenarios
 from tumble.io import write_run_folder
+from tumble.scenarios._base import ScenarioResult
 
 app = typer.Typer(
     help="Simulate rigid bodies and vibrating structures; write run folders.",
@@ -21,10 +31,54 @@ app = typer.Typer(
 console = Console()
 errors = Console(stderr=True)
 
+Out = Annotated[Path | None, typer.Option(help="Run folder (default: runs/<name>).")]
+Force = Annotated[bool, typer.Option(help="Overwrite files in an existing folder.")]
+
 
 def _fail(message: str) -> typer.Exit:
     errors.print(f"[bold red]error:[/] {message}", highlight=False)
     return typer.Exit(code=2)
+
+
+@contextmanager
+def _reported() -> Iterator[None]:
+    """Turn the library's ValueError (bad input) into exit code 2 with its message."""
+    try:
+        yield
+    except ValueError as error:
+        raise _fail(str(error)) from None
+
+
+@contextmanager
+def _progress(title: str) -> Iterator[Callable[[str], None]]:
+    """A progress display on a terminal (stages: the computation, then each file)."""
+    progress = Progress(
+        SpinnerColumn(),
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+        disable=not console.is_terminal,
+    )
+    with progress:
+        task = progress.add_task(title, total=None)
+        yield lambda stage: progress.update(task, description=f"{title}: {stage}")
+
+
+def _write(result: ScenarioResult, out: Path, force: bool, animation: bool, note) -> Path:
+    return write_run_folder(
+        result, out, force=force, animation=animation, on_file=lambda name: note(f"writing {name}")
+    )
+
+
+def _show_summary(title: str, summary: dict, folder: Path) -> None:
+    table = Table(title=f"{title}: {folder}", box=None, show_header=False)
+    for key, value in summary.items():
+        if isinstance(value, str | int | float | bool) or value is None:
+            table.add_row(key, value if isinstance(value, str) else json.dumps(value))
+    console.print(table)
+    console.print(f"full summary: {folder / 'summary.json'}", highlight=False)
 
 
 @app.command("list")
@@ -36,25 +90,206 @@ def list_scenarios() -> None:
     console.print(table)
 
 
+def _apply(name: str, options: dict, **overrides: Any) -> dict:
+    """Put ``--method``, ``--h`` and ``--t-end`` into ``options`` where the scenario takes them."""
+    parameters = inspect.signature(scenarios.get(name).run).parameters
+    options = dict(options)
+    for option, value in overrides.items():
+        if value is None:
+            continue
+        if option == "method" and "method" not in parameters and "methods" in parameters:
+            options["methods"] = [value]
+        elif option in parameters:
+            options[option] = value
+        else:
+            flag = "--" + option.replace("_", "-")
+            raise ValueError(
+                f"{flag}={value!r} does not apply to scenario {name!r}; "
+                f"its options are {sorted(parameters)}"
+            )
+    return options
+
+
+def _scenario(target: str) -> tuple[str, dict, bool, str]:
+    """``(scenario, options, animation, folder name)`` for a built-in name or a TOML file."""
+    from tumble.scenarios import files
+
+    if target.endswith(".toml") or Path(target).is_file():
+        spec = files.read(target)
+        return spec.scenario, dict(spec.options), bool(spec.outputs.animation), Path(target).stem
+    scenarios.get(target)  # unknown names fail here, listing the known ones
+    return target, {}, True, target
+
+
 @app.command()
 def run(
-    name: Annotated[str, typer.Argument(help="A built-in scenario (see `tumble list`).")],
-    out: Annotated[Path | None, typer.Option(help="Run folder (default: runs/NAME).")] = None,
-    force: Annotated[bool, typer.Option(help="Overwrite files in an existing folder.")] = False,
+    target: Annotated[
+        str, typer.Argument(metavar="NAME|FILE.toml", help="A built-in scenario or a TOML file.")
+    ],
+    out: Out = None,
+    method: Annotated[str | None, typer.Option(help="Integration method.")] = None,
+    h: Annotated[float | None, typer.Option("--h", help="Time step (s).")] = None,
+    t_end: Annotated[float | None, typer.Option(help="End time (s).")] = None,
+    animation: Annotated[
+        bool, typer.Option(help="Write animation.gif and view.html (slower).")
+    ] = True,
+    force: Force = False,
 ) -> None:
-    """Run a scenario and write its run folder (summary.json and pictures)."""
-    try:
-        scenario = scenarios.get(name)
-        result = scenario.run()
-        folder = write_run_folder(result, out or Path("runs") / name, force=force)
-    except ValueError as error:
-        raise _fail(str(error)) from None
-    table = Table(title=f"{name}: {folder}", box=None, show_header=False)
-    for key, value in result.summary.items():
-        if isinstance(value, str | int | float | bool) or value is None:
-            table.add_row(key, value if isinstance(value, str) else json.dumps(value))
+    """Run a scenario and write its run folder (data.nc, summary.json, pictures)."""
+    from tumble.scenarios import files
+
+    with _reported():
+        name, options, file_animation, default = _scenario(target)
+        options = _apply(name, options, method=method, h=h, t_end=t_end)
+        options = files.check_options(name, options)
+        with _progress(f"running {name}") as note:
+            result = scenarios.get(name).run(**options)
+            folder = _write(
+                result, out or Path("runs") / default, force, animation and file_animation, note
+            )
+    _show_summary(name, result.summary, folder)
+
+
+@app.command()
+def compare(
+    name: Annotated[str, typer.Argument(help="A scenario with a torque-free body.")],
+    methods: Annotated[
+        str | None, typer.Option(help="Comma-separated methods (default: all but euler).")
+    ] = None,
+    t_end: Annotated[float, typer.Option(help="End time (s).")] = 10.0,
+    out: Out = None,
+    force: Force = False,
+) -> None:
+    """Work–precision: error against wall time and steps for several methods."""
+    from tumble.scenarios import compare as comparison
+
+    chosen = comparison.DEFAULT_METHODS if methods is None else _split(methods)
+    with _reported(), _progress(f"comparing on {name}") as note:
+        result = comparison.run(name, methods=chosen, t_end=t_end)
+        folder = _write(result, out or Path("runs") / f"{name}-compare", force, False, note)
+    table = Table(title=f"{name}: work–precision, T = {t_end:g} s", box=None)
+    for column in ("method", "h or rtol", "steps", "time [ms]", "error |R − R_exact|"):
+        table.add_column(column, justify="left" if column == "method" else "right")
+    for row in result.summary["points"]:
+        table.add_row(
+            row["method"],
+            f"{row['setting']:.3g}",
+            str(row["steps"]),
+            f"{row['seconds'] * 1e3:.3f}",
+            f"{row['error']:.2e}",
+        )
     console.print(table)
-    console.print(f"full summary: {folder / 'summary.json'}", highlight=False)
+    console.print(f"plot: {folder / 'work_precision.png'}", highlight=False)
+
+
+def _split(methods: str) -> list[str]:
+    return [m.strip() for m in methods.split(",") if m.strip()]
+
+
+@app.command()
+def stability(
+    n_elements: Annotated[int, typer.Option(help="Beam elements.")] = 20,
+    steps: Annotated[int, typer.Option(help="Steps per run of the sweep.")] = 1000,
+    out: Out = None,
+    force: Force = False,
+) -> None:
+    """The cantilever's time-step sweep: which scheme stays bounded at which Δt."""
+    from tumble.scenarios import beam
+
+    with _reported(), _progress("stability sweep") as note:
+        result = beam.stability(n_elements=n_elements, sweep_steps=steps)
+        folder = _write(result, out or Path("runs") / "stability", force, False, note)
+    summary = result.summary
+    table = Table(
+        title=f"critical Δt (semi-implicit) = {summary['critical_dt_semi_implicit']:.4g} s "
+        f"({summary['critical_mode']} mode)",
+        box=None,
+    )
+    table.add_column("Δt / Δt_crit", justify="right")
+    table.add_column("Δt [s]", justify="right")
+    for scheme in summary["schemes"]:
+        table.add_column(scheme)
+    verdicts = [summary["schemes"][s]["stable"] for s in summary["schemes"]]
+    for k, (factor, dt) in enumerate(zip(summary["factors"], summary["dt"], strict=True)):
+        cells = ["stable" if verdict[k] else "[red]grows[/]" for verdict in verdicts]
+        table.add_row(f"{factor:g}", f"{dt:.3g}", *cells)
+    console.print(table)
+    console.print(f"plot: {folder / 'stability_sweep.png'}", highlight=False)
+
+
+@app.command()
+def view(
+    run_dir: Annotated[Path, typer.Argument(help="A run folder written by `tumble run`.")],
+    open_browser: Annotated[
+        bool, typer.Option("--open/--no-open", help="Open the page in a web browser.")
+    ] = True,
+) -> None:
+    """Write (if missing) and open the run's interactive viewer, view.html."""
+    with _reported():
+        page = _viewer(run_dir)
+    console.print(f"viewer: {page}", highlight=False)
+    if open_browser and not webbrowser.open(page.resolve().as_uri()):
+        console.print("no web browser found; open the file above yourself")
+
+
+def _viewer(run_dir: Path) -> Path:
+    """The run's ``view.html``, drawn again from ``data.nc`` when it is not there."""
+    page = run_dir / "view.html"
+    if page.is_file():
+        return page
+    import trimesh
+
+    from tumble.io import atomic_write, load
+    from tumble.rigid import Trajectory
+    from tumble.viz.html import html_viewer
+
+    run = load(run_dir)
+    if "mesh" not in run.groups:
+        raise ValueError(
+            f"run_dir={str(run_dir)!r} holds no body mesh (scenario "
+            f"{run.attrs.get('scenario')!r}); the viewer shows rigid-body runs only"
+        )
+    mesh_data = run.dataset("mesh")
+    mesh = trimesh.Trimesh(mesh_data["vertices"].values, mesh_data["faces"].values, process=False)
+    shows = mesh_data.attrs["shows"]
+    trajectory = Trajectory.from_xarray(run.dataset(shows))
+    title = f"{run.attrs.get('scenario')} — {shows}, {trajectory.method}"
+    atomic_write(page, lambda tmp: html_viewer(trajectory, mesh, tmp, title=title))
+    return page
+
+
+@app.command("mass")
+def mass_properties(
+    mesh_file: Annotated[Path, typer.Argument(help="A closed triangle mesh (STL, OBJ, PLY…).")],
+    density: Annotated[float, typer.Option(help="Density (kg/m³).")],
+    fix_inside_out: Annotated[
+        bool, typer.Option(help="Flip an inside-out mesh instead of refusing it.")
+    ] = False,
+) -> None:
+    """Mass, centre of mass, inertia and principal axes of a mesh of uniform density."""
+    from tumble import mass, meshes
+
+    with _reported():
+        mesh = meshes.load(mesh_file)
+        properties = mass.from_mesh(mesh, density=density, fix_inside_out=fix_inside_out)
+        moments, axes = properties.principal()
+    table = Table(title=f"{mesh_file} at ρ = {density:g} kg/m³", box=None)
+    table.add_column("quantity")
+    table.add_column("unit")
+    table.add_column("value", no_wrap=True)
+    table.add_row("volume", "m³", f"{properties.mass / density:.6g}")
+    table.add_row("mass", "kg", f"{properties.mass:.6g}")
+    table.add_row("centre of mass", "m", _vector(properties.com))
+    for k, row in enumerate(properties.inertia):
+        table.add_row("inertia (COM)" if k == 0 else "", "kg m²" if k == 0 else "", _vector(row))
+    table.add_row("principal moments", "kg m²", _vector(moments))
+    for k, column in enumerate(axes.T):
+        table.add_row(f"principal axis {k + 1}", "", _vector(column))
+    console.print(table)
+
+
+def _vector(values) -> str:
+    return " ".join(f"{v: .5e}" for v in values)
 
 
 def main() -> None:  # pragma: no cover - console-script entry

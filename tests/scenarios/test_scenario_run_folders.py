@@ -1,0 +1,61 @@
+"""Each built-in scenario, run short, writes every file it promises, and reads back."""
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from tumble import io, scenarios
+
+SHORT = {
+    "projectile": {"h": 0.5},
+    "torus-spin": {"t_end": 2.0, "methods": ["rk4-matrix", "rkmk4"]},
+    "prism-impulse": {"t_end": 1.0, "methods": ["rkmk4"]},
+    "sphere-exact": {"methods": ["euler", "rkmk4"]},
+    "t-handle": {"t_end": 2.0, "spins": [[1.0, 0.05, 0.0]]},
+    "convergence": {"step_counts": [50, 100], "methods": ["rkmk4"]},
+    "beam": {"n_elements": 8, "n_steps": 200, "sweep_steps": 100},
+}
+RIGID = {"animation.gif", "view.html", "data.nc"}
+PROMISED = {
+    "projectile": {"trajectory.png", "data.nc"},
+    "torus-spin": {"drift.png", "error_vs_exact.png", "rotation_grid.png"} | RIGID,
+    "prism-impulse": {"snapshots.png", "drift.png", "rotation_grid.png"} | RIGID,
+    "sphere-exact": {"error_vs_exact.png", "rotation_grid.png", "drift.png"} | RIGID,
+    "t-handle": {
+        "rotation_grid_spin1.png", "euler_angles_spin1.png", "angular_velocity.png", "drift.png"
+    } | RIGID,
+    "convergence": {"convergence.png", "data.nc"},
+    "beam": {f"energy_{s}.png" for s in ("explicit", "semi-implicit", "implicit", "midpoint")}
+    | {"stability_sweep.png", "beam_shapes.png", "animation.gif", "data.nc"},
+}  # fmt: skip
+
+
+def test_every_built_in_scenario_is_covered():
+    assert set(SHORT) == set(PROMISED) == set(scenarios.names()) - {"rigid-body"}
+
+
+@pytest.mark.parametrize("name", sorted(SHORT))
+def test_scenario_writes_every_promised_file(name, tmp_path):
+    result = scenarios.get(name).run(**SHORT[name])
+    io.write_run_folder(result, tmp_path)
+    written = {p.name for p in tmp_path.iterdir()}
+    assert written == PROMISED[name] | {"summary.json"}
+    summary = json.loads((tmp_path / "summary.json").read_text())
+    assert set(summary["files"]) == PROMISED[name]
+    for png in tmp_path.glob("*.png"):
+        with Image.open(png) as image:
+            assert image.format == "PNG" and min(image.size) > 200
+    if "animation.gif" in written:
+        with Image.open(tmp_path / "animation.gif") as gif:
+            assert gif.format == "GIF" and gif.n_frames >= 10
+    if "view.html" in written:
+        assert "Plotly" in (tmp_path / "view.html").read_text(encoding="utf-8")
+    run = io.load(tmp_path)
+    assert run.attrs["scenario"] == name
+    for group in run.groups:
+        dataset = run.dataset(group)
+        assert dataset.data_vars and all(
+            np.isfinite(dataset[v].values).any() for v in dataset.data_vars if v != "method"
+        )
