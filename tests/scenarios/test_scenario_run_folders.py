@@ -1,6 +1,7 @@
 """Each built-in scenario, run short, writes every file it promises, and reads back."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -59,3 +60,31 @@ def test_scenario_writes_every_promised_file(name, tmp_path):
         assert dataset.data_vars and all(
             np.isfinite(dataset[v].values).any() for v in dataset.data_vars if v != "method"
         )
+
+
+EXAMPLES = sorted(Path("examples").glob("*.toml"))
+SHORTER = {"t_end": 0.5}
+
+
+def test_there_is_an_example_file_for_every_scenario():
+    from tumble.scenarios import files
+
+    assert {files.read(path).scenario for path in EXAMPLES} == set(scenarios.names())
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_example_file_runs_and_writes_every_file(path, tmp_path):
+    from tumble.scenarios import files
+
+    spec = files.read(path)
+    options = {**spec.options, **SHORT.get(spec.scenario, {})}
+    if spec.scenario == "rigid-body":
+        options.update(SHORTER)
+    result = scenarios.get(spec.scenario).run(**files.check_options(spec.scenario, options))
+    io.write_run_folder(result, tmp_path, animation=spec.outputs.animation)
+    promised = {name for name, _ in result.figures} | {"data.nc", "summary.json"}
+    if spec.outputs.animation:
+        promised |= {name for name, _ in result.animations}
+    assert {p.name for p in tmp_path.iterdir()} == promised
+    sizes = {name: (tmp_path / name).stat().st_size for name in promised - {"summary.json"}}
+    assert min(sizes.values()) > 1000, sizes
