@@ -72,13 +72,36 @@ def _write(result: ScenarioResult, out: Path, force: bool, animation: bool, note
     )
 
 
+MAX_ROWS = 40
+"""The printed summary stops after this many numbers (summary.json has them all)."""
+
+
+def _scalars(value: Any, key: str = "") -> Iterator[tuple[str, str]]:
+    """``(dotted key, text)`` for every number or string in a nested summary."""
+    if isinstance(value, dict):
+        for name, item in value.items():
+            yield from _scalars(item, f"{key}.{name}" if key else str(name))
+    elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+        for k, item in enumerate(value, start=1):
+            yield from _scalars(item, f"{key}[{k}]")
+    elif isinstance(value, float):
+        yield key, f"{value:.6g}"
+    elif isinstance(value, str):
+        yield key, value
+    elif isinstance(value, list) and value and all(isinstance(v, float) for v in value):
+        yield key, "[" + ", ".join(f"{v:.6g}" for v in value) + "]"
+    elif key != "files":
+        yield key, json.dumps(value)
+
+
 def _show_summary(title: str, summary: dict, folder: Path) -> None:
     table = Table(title=f"{title}: {folder}", box=None, show_header=False)
-    for key, value in summary.items():
-        if isinstance(value, str | int | float | bool) or value is None:
-            table.add_row(key, value if isinstance(value, str) else json.dumps(value))
+    rows = list(_scalars(summary))
+    for key, text in rows[:MAX_ROWS]:
+        table.add_row(key, text if len(text) < 60 else text[:57] + "…")
     console.print(table)
-    console.print(f"full summary: {folder / 'summary.json'}", highlight=False)
+    more = f" ({len(rows) - MAX_ROWS} more numbers)" if len(rows) > MAX_ROWS else ""
+    console.print(f"full summary{more}: {folder / 'summary.json'}", highlight=False)
 
 
 @app.command("list")
