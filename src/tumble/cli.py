@@ -191,7 +191,7 @@ def compare(
         result = comparison.run(name, methods=chosen, t_end=t_end)
         folder = _write(result, out or Path("runs") / f"{name}-compare", force, False, note)
     table = Table(title=f"{name}: work–precision, T = {t_end:g} s", box=None)
-    for column in ("method", "h or rtol", "steps", "time [ms]", "error |R − R_exact|"):
+    for column in ("method", "h or rtol", "steps", "ms", "error |R − R_exact|"):
         table.add_column(column, justify="left" if column == "method" else "right")
     for row in result.summary["points"]:
         table.add_row(

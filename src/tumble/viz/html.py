@@ -402,9 +402,9 @@ def _layout(fig, title: str, times, world: np.ndarray, arrows, energy_range) -> 
         for name, c in zip("xyz", center, strict=True)
     }
     fig.update_layout(
-        title={"text": title, "x": 0.5, "xanchor": "center"},
-        height=850,
-        margin={"l": 60, "r": 30, "t": 60, "b": 50},
+        title={"text": html.escape(title).replace("\n", "<br>"), "x": 0.5, "xanchor": "center"},
+        height=850 + 20 * title.count("\n"),
+        margin={"l": 60, "r": 30, "t": 60 + 20 * title.count("\n"), "b": 50},
         showlegend=False,
         uirevision="tumble",
         scene={
