@@ -21,32 +21,26 @@ Loads are constant: ``gravity`` (``g`` in m/s²); ``force`` (``force`` in N, wor
 a ``point`` fixed on the body, in the description's coordinates; default the centre of
 mass); ``torque`` (N m, world frame); ``impulse`` (``impulse`` in N s at the world
 ``point`` at ``time``).
+
+The body models are in :mod:`tumble.scenarios.bodies`; this module holds the rest of
+:data:`OPTIONS` (initial state, loads, method) and :func:`run`.
 """
 
 from __future__ import annotations
 
 from functools import partial
-from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal, Union
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
-import trimesh
-from pydantic import (
-    AfterValidator,
-    Discriminator,
-    Field,
-    Tag,
-    ValidationInfo,
-    field_validator,
-    model_validator,
-)
+from pydantic import AfterValidator, Field, model_validator
 
-from tumble import mass, meshes, so3
+from tumble import so3
 from tumble.rigid import Force, Gravity, Impulse, RigidBody, Torque, Trajectory, simulate
 from tumble.rigid.initial import check_steps, initial_attitude
 from tumble.rigid.methods import METHODS, get_method
 from tumble.scenarios._base import ScenarioResult, rigid_animations, rigid_attrs, rigid_datasets
-from tumble.scenarios.files import (
+from tumble.scenarios.bodies import Body
+from tumble.scenarios.schema import (
     Matrix3,
     NonNegative,
     Positive,
@@ -55,6 +49,7 @@ from tumble.scenarios.files import (
     Text,
     Vector3,
     Vector4,
+    check_table,
     custom_error,
     one_of,
     validate,
@@ -63,240 +58,6 @@ from tumble.viz import rigid
 
 NAME = "rigid-body"
 SUMMARY = "Your own body (primitive, composite or mesh file) with loads, from a scenario file."
-
-
-def _checked(build):
-    """``build()``; a ValueError from the library becomes an error of the whole table."""
-    try:
-        return build()
-    except ValueError as error:
-        raise custom_error("whole_invalid", "{reason}", reason=str(error)) from None
-
-
-def _axis(value: Any) -> str | list[float]:
-    if isinstance(value, str) and value in mass.AXES:
-        return value
-    if not isinstance(value, str | bool):
-        try:
-            mass.axis_vector(value)
-            return np.asarray(value, dtype=float).tolist()
-        except (TypeError, ValueError):
-            pass
-    raise custom_error("axis", 'must be "x", "y", "z" or a nonzero vector of 3 numbers')
-
-
-Axis = Annotated[Any, AfterValidator(_axis)]
-"""``"x"``, ``"y"``, ``"z"`` or a nonzero 3-vector."""
-
-# --- bodies ------------------------------------------------------------------------------
-
-
-class _Solid(Section):
-    """A primitive of :mod:`tumble.mass` and :mod:`tumble.meshes`, named by ``shape``.
-
-    Each primitive lists its ``dimensions`` (passed first, in order) and its ``placement``
-    keys; both modules take the same arguments, plus ``density`` (kg/m³) or ``mass`` (kg)
-    for the mass properties.
-    """
-
-    dimensions: ClassVar[tuple[str, ...]] = ()
-    placement: ClassVar[tuple[str, ...]] = ("axis", "center")
-    density: Positive | None = None
-    mass: Positive | None = None
-    center: Vector3 = [0.0, 0.0, 0.0]
-
-    @model_validator(mode="after")
-    def _consistent(self) -> _Solid:
-        if (self.density is None) == (self.mass is None):
-            given = "both" if self.density is not None else "neither"
-            raise custom_error(
-                "whole_amount",
-                "a {shape} needs exactly one of density (kg/m³) or mass (kg); got {given}",
-                shape=self.shape,
-                given=given,
-            )
-        _checked(self.mass_properties)
-        return self
-
-    def _arguments(self) -> tuple[list, dict[str, Any]]:
-        sizes = [getattr(self, name) for name in self.dimensions]
-        return sizes, {name: getattr(self, name) for name in self.placement}
-
-    def mass_properties(self) -> mass.MassProperties:
-        """Mass, centre of mass (m) and inertia (kg m²) in the description's coordinates."""
-        sizes, placement = self._arguments()
-        build = getattr(mass, self.shape)
-        return build(*sizes, density=self.density, mass=self.mass, **placement)
-
-    def surface(self) -> trimesh.Trimesh:
-        """The closed triangle mesh, in the description's coordinates."""
-        sizes, placement = self._arguments()
-        return getattr(meshes, self.shape)(*sizes, **placement)
-
-    def label(self) -> str:
-        return self.shape
-
-
-class Cylinder(_Solid):
-    """A solid circular cylinder: ``radius`` and ``length`` (m) along ``axis``."""
-
-    what: ClassVar[str] = "a key of a cylinder"
-    dimensions: ClassVar[tuple[str, ...]] = ("radius", "length")
-    shape: Literal["cylinder"]
-    radius: Positive
-    length: Positive
-    axis: Axis = "z"
-
-
-class HexPrism(_Solid):
-    """A regular hexagonal prism: ``circumradius`` (= side) and ``length`` (m) along ``axis``."""
-
-    what: ClassVar[str] = "a key of a hex_prism"
-    dimensions: ClassVar[tuple[str, ...]] = ("circumradius", "length")
-    shape: Literal["hex_prism"]
-    circumradius: Positive
-    length: Positive
-    axis: Axis = "z"
-
-
-class Torus(_Solid):
-    """A ring torus: ``major_radius`` and ``minor_radius`` (m); ``axis`` through the hole."""
-
-    what: ClassVar[str] = "a key of a torus"
-    dimensions: ClassVar[tuple[str, ...]] = ("major_radius", "minor_radius")
-    shape: Literal["torus"]
-    major_radius: Positive
-    minor_radius: Positive
-    axis: Axis = "z"
-
-
-class Sphere(_Solid):
-    """A solid sphere of ``radius`` (m)."""
-
-    what: ClassVar[str] = "a key of a sphere"
-    dimensions: ClassVar[tuple[str, ...]] = ("radius",)
-    placement: ClassVar[tuple[str, ...]] = ("center",)
-    shape: Literal["sphere"]
-    radius: Positive
-
-
-class Box(_Solid):
-    """A box of edge lengths ``extents`` (m), turned by ``rotation`` (3×3, body to world)."""
-
-    what: ClassVar[str] = "a key of a box"
-    dimensions: ClassVar[tuple[str, ...]] = ("extents",)
-    placement: ClassVar[tuple[str, ...]] = ("rotation", "center")
-    shape: Literal["box"]
-    extents: Vector3
-    rotation: Matrix3 | None = None
-
-
-Primitive = Annotated[Cylinder | Box | Sphere | Torus | HexPrism, Field(discriminator="shape")]
-
-
-class MeshBody(Section):
-    """A closed triangle mesh file of uniform ``density``; its coordinates times ``scale``."""
-
-    what: ClassVar[str] = "a key of a mesh body"
-    mesh: Text
-    density: Positive
-    scale: Positive = 1.0
-
-    @field_validator("mesh")
-    @classmethod
-    def _solid_file(cls, value: str, info: ValidationInfo) -> str:
-        """Resolve ``mesh`` against the file's folder; it must be a closed, outward mesh."""
-        folder = (info.context or {}).get("folder") or Path.cwd()
-        path = (Path(folder) / value).resolve()
-        if not path.is_file():
-            raise custom_error("file", "no such file (looked for {path})", path=str(path))
-        try:
-            surface = meshes.validate_solid(meshes.load(path), name="the mesh")
-        except ValueError as error:
-            raise custom_error("mesh", "{reason}", reason=str(error)) from None
-        if surface.volume < 0:
-            raise custom_error(
-                "inside_out",
-                "the mesh is inside-out (negative volume); flip its faces (trimesh: "
-                "mesh.invert()) and save it again",
-            )
-        return str(path)
-
-    @model_validator(mode="after")
-    def _consistent(self) -> MeshBody:
-        _checked(self.mass_properties)
-        return self
-
-    def surface(self) -> trimesh.Trimesh:
-        return meshes.load(self.mesh).apply_scale(self.scale)
-
-    def mass_properties(self) -> mass.MassProperties:
-        return mass.from_mesh(self.surface(), density=self.density)
-
-    def label(self) -> str:
-        return f"mesh {Path(self.mesh).name}"
-
-
-_KEYS = {"shape": "<primitive>", "mesh": "<mesh>", "parts": "<composite>"}
-"""A body's kind, by the key that says it (the tags stay out of error messages)."""
-
-
-def _kind(value: Any) -> str | None:
-    if isinstance(value, dict):
-        return next((tag for key, tag in _KEYS.items() if key in value), None)
-    if isinstance(value, MeshBody | Composite):
-        return _KEYS["mesh" if isinstance(value, MeshBody) else "parts"]
-    return _KEYS["shape"] if isinstance(value, _Solid) else None
-
-
-def _union(members: dict[str, Any], message: str) -> Any:
-    tagged = tuple(Annotated[kind, Tag(tag)] for tag, kind in members.items())
-    return Annotated[
-        Union[tagged],  # noqa: UP007 - built from a tuple
-        Discriminator(_kind, custom_error_type="whole_kind", custom_error_message=message),
-    ]
-
-
-Part = _union(
-    {"<primitive>": Primitive, "<mesh>": MeshBody},
-    "each part needs a shape (cylinder, box, sphere, torus, hex_prism) or a mesh file",
-)
-
-
-class Composite(Section):
-    """Parts added by the parallel-axis theorem; ``density`` is the default of each part."""
-
-    what: ClassVar[str] = "a key of a composite body"
-    parts: Annotated[list[Part], Field(min_length=1)]
-    density: Positive | None = None
-
-    @model_validator(mode="before")
-    @classmethod
-    def _share_density(cls, data: Any) -> Any:
-        if isinstance(data, dict) and "density" in data and isinstance(data.get("parts"), list):
-            parts = [
-                {**part, "density": data["density"]}
-                if isinstance(part, dict) and not {"density", "mass"} & set(part)
-                else part
-                for part in data["parts"]
-            ]
-            data = {**data, "parts": parts}
-        return data
-
-    def mass_properties(self) -> mass.MassProperties:
-        return sum(part.mass_properties() for part in self.parts)
-
-    def surface(self) -> trimesh.Trimesh:
-        return trimesh.util.concatenate([part.surface() for part in self.parts])
-
-    def label(self) -> str:
-        return "composite (" + " + ".join(part.label() for part in self.parts) + ")"
-
-
-Body = _union(
-    {"<primitive>": Primitive, "<mesh>": MeshBody, "<composite>": Composite},
-    "the body needs shape (a primitive), parts (a composite) or mesh (a mesh file)",
-)
 
 # --- initial state and loads ---------------------------------------------------------------
 
@@ -325,7 +86,7 @@ class Initial(Section):
                     group=", ".join(group),
                     given=" and ".join(given),
                 )
-        _checked(self.attitude)
+        check_table(self.attitude)
         return self
 
     def attitude(self) -> np.ndarray:
@@ -401,7 +162,7 @@ class Options(Section):
 
     @model_validator(mode="after")
     def _consistent(self) -> Options:
-        _checked(lambda: check_steps(get_method(self.method), self.h, self.rtol, self.atol))
+        check_table(lambda: check_steps(get_method(self.method), self.h, self.rtol, self.atol))
         for index, load in enumerate(self.loads):
             if isinstance(load, ImpulseLoad) and load.time > self.t_end:
                 raise custom_error(

@@ -6,15 +6,14 @@ turned into arrows (:func:`load_arrows`), and one matplotlib figure on the Agg c
 updated and drawn once per frame. Frames become a GIF through Pillow (one palette for all
 frames, so unchanged pixels cost nothing) or an MP4 through ``ffmpeg``
 (:func:`mp4_available`), chosen by the path's suffix alone, so a temporary name such as
-``.animation.partial.gif`` works.
+``.animation.partial.gif`` works. The writing is in :mod:`tumble.viz._writers`;
+:func:`write_animation`, :func:`animation_format` and :func:`mp4_available` are re-exported.
 
-matplotlib and Pillow are imported inside the functions that draw and write.
+matplotlib is imported inside the functions that draw.
 """
 
 from __future__ import annotations
 
-import shutil
-import subprocess
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,18 +25,23 @@ from numpy.typing import ArrayLike, NDArray
 from tumble import so3
 from tumble.rigid.forces import Force, Gravity, Impulse, State, Torque, split_loads
 from tumble.viz._figure import new_figure
+from tumble.viz._writers import (
+    FORMATS,
+    GIF_COLOURS,
+    LOAD_COLOURS,
+    animation_format,
+    check_positive,
+    mp4_available,
+    write_animation,
+)
 
 if TYPE_CHECKING:
     import trimesh
 
     from tumble.rigid import Trajectory
 
-FORMATS = (".gif", ".mp4")
-"""Suffixes the animation writers accept."""
 PIXELS_PER_INCH = 100
 """Figure dpi of the frames, so ``size`` in pixels is ``figsize × 100``."""
-GIF_COLOURS = 64
-"""Palette size of a GIF (80 frames of 480 × 480 px come to about 0.5–1 MB)."""
 IMPULSE_SHOWN = 0.5
 """An impulse's arrow is shown for this long (s) centred on its time, and in at least the
 frames within 1.5 frame spacings of it."""
@@ -46,7 +50,6 @@ ARROW_FRACTION = 0.4
 LIGHT = np.array([-0.196, -0.539, 0.819]) / np.linalg.norm([-0.196, -0.539, 0.819])
 """Direction (world) the light comes from, for the Lambert shading of the faces."""
 BODY_COLOUR = np.array([0.12, 0.47, 0.71])
-LOAD_COLOURS = {"impulse": "tab:red", "force": "tab:orange"}
 
 
 @dataclass(frozen=True)
@@ -78,35 +81,6 @@ class Arrow(NamedTuple):
     tail: NDArray[np.float64]
     head: NDArray[np.float64]
     kind: str
-
-
-def mp4_available() -> bool:
-    """Whether ``ffmpeg`` is on ``PATH`` (needed to write ``.mp4``)."""
-    return shutil.which("ffmpeg") is not None
-
-
-def animation_format(path: str | Path) -> str:
-    """The format ``"gif"`` or ``"mp4"`` for ``path``, from its suffix only.
-
-    Raises
-    ------
-    ValueError
-        If the suffix is neither ``.gif`` nor ``.mp4``.
-    RuntimeError
-        If it is ``.mp4`` and ``ffmpeg`` is not on ``PATH``.
-    """
-    suffix = Path(path).suffix.lower()
-    if suffix not in FORMATS:
-        raise ValueError(
-            f"path={str(path)!r} has suffix {suffix!r}; an animation is written as one of "
-            f"{list(FORMATS)}"
-        )
-    if suffix == ".mp4" and not mp4_available():
-        raise RuntimeError(
-            f"path={str(path)!r}: writing .mp4 needs ffmpeg on PATH; install it "
-            "(e.g. apt-get install ffmpeg) or write a .gif"
-        )
-    return suffix[1:]
 
 
 def resample(trajectory: Trajectory, frames: int) -> Frames:
@@ -284,12 +258,6 @@ def _count(name: str, value: object, *, minimum: int) -> int:
     return int(value)
 
 
-def _positive(name: str, value: object) -> float:
-    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
-        raise ValueError(f"{name}={value!r} must be a positive number")
-    return float(value)
-
-
 def animate_body(
     trajectory: Trajectory,
     mesh: trimesh.Trimesh,
@@ -344,7 +312,7 @@ def animate_body(
         ``.mp4`` without ffmpeg on ``PATH``.
     """
     animation_format(path)  # refuse a bad suffix before rendering
-    fps = _positive("fps", fps)
+    fps = check_positive("fps", fps)
     width, height = (_count("size", value, minimum=16) for value in size)
     sampled = resample(trajectory, frames)
     vertices, faces = np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces)
@@ -443,56 +411,22 @@ def _equal_limits(axes, points: NDArray) -> None:
     axes.set_box_aspect((1, 1, 1))
 
 
-def write_animation(images: Sequence[NDArray], path: str | Path, *, fps: float = 20) -> Path:
-    """Write RGB frames (each shape (height, width, 3), uint8) as a GIF or an MP4.
-
-    GIF: Pillow, looping, every frame mapped (no dithering) onto one palette of
-    :data:`GIF_COLOURS` colours: the median cut of all frames (every fourth pixel), plus the
-    load arrows' colours, which are too few pixels to survive the cut. MP4: ffmpeg, H.264 in
-    yuv420p (odd sizes padded by one pixel). The format comes from the suffix of ``path``
-    only (:func:`animation_format`).
-
-    Returns
-    -------
-    Path
-        ``path``.
-    """
-    kind = animation_format(path)
-    fps = _positive("fps", fps)
-    if len(images) == 0:
-        raise ValueError("images is empty; pass at least one frame")
-    path = Path(path)
-    if kind == "gif":
-        from PIL import Image
-
-        palette = _gif_palette(images)
-        frames = [
-            Image.fromarray(image).quantize(palette=palette, dither=Image.Dither.NONE)
-            for image in images
-        ]
-        frames[0].save(path, format="GIF", save_all=True, append_images=frames[1:],
-                       duration=round(1000 / fps), loop=0, optimize=True)  # fmt: skip
-        return path
-    height, width = images[0].shape[:2]
-    command = ["ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
-               "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
-               "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
-               "-pix_fmt", "yuv420p", "-f", "mp4", str(path)]  # fmt: skip
-    data = b"".join(np.ascontiguousarray(image, dtype=np.uint8).tobytes() for image in images)
-    result = subprocess.run(command, input=data, capture_output=True, check=False)
-    if result.returncode != 0:
-        raise RuntimeError(f"ffmpeg failed writing {str(path)!r}: {result.stderr.decode()}")
-    return path
-
-
-def _gif_palette(images: Sequence[NDArray]):
-    """One palette image for every frame (see :func:`write_animation`)."""
-    from matplotlib.colors import to_rgb
-    from PIL import Image
-
-    mosaic = Image.fromarray(np.concatenate([image[::4, ::4] for image in images], axis=0))
-    reserved = [round(255 * c) for colour in LOAD_COLOURS.values() for c in to_rgb(colour)]
-    cut = mosaic.quantize(GIF_COLOURS - len(LOAD_COLOURS), dither=Image.Dither.NONE)
-    palette = Image.new("P", (1, 1))
-    palette.putpalette(cut.getpalette()[: 3 * (GIF_COLOURS - len(LOAD_COLOURS))] + reserved)
-    return palette
+__all__ = [
+    "ARROW_FRACTION",
+    "BODY_COLOUR",
+    "FORMATS",
+    "GIF_COLOURS",
+    "IMPULSE_SHOWN",
+    "LIGHT",
+    "LOAD_COLOURS",
+    "PIXELS_PER_INCH",
+    "Arrow",
+    "Frames",
+    "animate_body",
+    "animation_format",
+    "load_arrows",
+    "mp4_available",
+    "resample",
+    "world_vertices",
+    "write_animation",
+]

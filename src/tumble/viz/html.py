@@ -12,7 +12,8 @@ The animation has one plotly frame per shown time: the recorded sample nearest t
 frames). The faces are sent once; a frame carries only the vertex coordinates, as float32
 (7 significant digits, ample for a picture and half the size of float64). The mesh is drawn
 smooth-shaded with its vertices split along sharp edges (:func:`display_mesh`): plotly's flat
-shading drew jagged dark patches on a torus in software WebGL (SwiftShader).
+shading drew jagged dark patches on a torus in software WebGL (SwiftShader). How the figure
+looks (colours, axes, the play controls) is in :mod:`tumble.viz._viewer_layout`.
 
 plotly is imported only inside the functions.
 """
@@ -28,6 +29,22 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from tumble.rigid.forces import Force, Gravity, Impulse, Torque
+from tumble.viz._viewer_layout import (
+    ARROW_COLOR,
+    ENERGY_POINTS,
+    ENERGY_TOP,
+    FRAME_DURATION_MS,
+    MESH_COLOR,
+    NOW_COLOR,
+    SCENE_BOTTOM,
+    SLIDER_TOP,
+    apply_layout,
+    controls,
+    energy_curve,
+    style_arrow,
+    style_mesh,
+    style_now,
+)
 
 if TYPE_CHECKING:
     import plotly.graph_objects
@@ -43,17 +60,8 @@ IMPULSE_WINDOW_FRAMES = 2
 """An impulse's arrow is shown in the frames within this many frame spacings of its time."""
 ARROW_LENGTH = 0.6
 """Length of an impulse arrow as a fraction of the mesh's largest extent."""
-ENERGY_POINTS = 5000
-"""Longer energy curves are thinned to about this many samples (the last one kept)."""
-FRAME_DURATION_MS = (40, 400)
-"""Bounds on the time a frame is shown when playing (ms); between them the play is real-time."""
 SHARP_EDGE_DEGREES = 30.0
 """Edges whose faces meet at a larger angle are drawn sharp, the others smooth."""
-MESH_COLOR = "#4c78a8"
-ARROW_COLOR = "#d62728"
-NOW_COLOR = "#e45756"
-SCENE_BOTTOM, SLIDER_TOP, ENERGY_TOP = 0.42, 0.405, 0.25
-"""Vertical layout (fractions of the plot area): the scene above, the slider, the energy."""
 
 
 def html_viewer(
@@ -171,11 +179,11 @@ def viewer_figure(
 
     fig = make_subplots(rows=2, cols=1, specs=[[{"type": "scene"}], [{"type": "xy"}]])
     first = animated(0)
-    fig.add_trace(_style_mesh(first[0], faces), row=1, col=1)
+    fig.add_trace(style_mesh(first[0], faces), row=1, col=1)
     for line, cone in zip(first[1:-2:2], first[2:-2:2], strict=True):
-        fig.add_traces(_style_arrow(line, cone), rows=1, cols=1)
-    fig.add_trace(_energy_curve(t, energy), row=2, col=1)
-    fig.add_traces(_style_now(*first[-2:]), rows=2, cols=1)
+        fig.add_traces(style_arrow(line, cone), rows=1, cols=1)
+    fig.add_trace(energy_curve(t, energy), row=2, col=1)
+    fig.add_traces(style_now(*first[-2:]), rows=2, cols=1)
 
     animated_indices = [0, *range(1, 1 + 2 * len(arrows)), len(fig.data) - 2, len(fig.data) - 1]
     names = [str(k) for k in range(len(index))]
@@ -183,8 +191,8 @@ def viewer_figure(
         go.Frame(name=name, data=animated(k), traces=animated_indices)
         for k, name in enumerate(names)
     ]
-    _layout(fig, title, times, world, arrows, energy_range)
-    fig.update_layout(**_controls(names, times))
+    apply_layout(fig, title, times, world, arrows, energy_range)
+    fig.update_layout(**controls(names, times))
     return fig
 
 
@@ -323,147 +331,22 @@ def _padded_range(values: np.ndarray) -> list[float]:
     return [low - margin, high + margin]
 
 
-def _style_mesh(mesh_trace, faces: np.ndarray):
-    i, j, k = faces.T
-    return mesh_trace.update(
-        i=i,
-        j=j,
-        k=k,
-        color=MESH_COLOR,
-        flatshading=False,
-        lighting={"ambient": 0.3, "diffuse": 0.9, "specular": 0.3, "roughness": 0.5},
-        lightposition={"x": 1e3, "y": 5e2, "z": 3e3},
-        name="body",
-        hoverinfo="skip",
-    )
-
-
-def _style_arrow(line, cone) -> tuple:
-    line = line.update(mode="lines", line={"color": ARROW_COLOR, "width": 6}, name="impulse")
-    cone = cone.update(
-        sizemode="raw",
-        anchor="tip",
-        colorscale=[[0, ARROW_COLOR], [1, ARROW_COLOR]],
-        showscale=False,
-        name="impulse",
-        hoverinfo="name",
-    )
-    return line, cone
-
-
-def _energy_curve(t: np.ndarray, energy: np.ndarray):
-    import plotly.graph_objects as go
-
-    keep = np.arange(0, len(t), max(1, -(-len(t) // ENERGY_POINTS)))
-    keep = np.union1d(keep, [len(t) - 1])
-    return go.Scatter(
-        x=t[keep],
-        y=energy[keep],
-        mode="lines",
-        line={"color": MESH_COLOR, "width": 2},
-        name="kinetic energy",
-        hovertemplate="t = %{x:.4g} s<br>E = %{y:.8g} J<extra></extra>",
-    )
-
-
-def _style_now(line, marker) -> tuple:
-    line = line.update(
-        mode="lines", line={"color": NOW_COLOR, "width": 1.5, "dash": "dot"}, hoverinfo="skip"
-    )
-    marker = marker.update(
-        mode="markers",
-        marker={"color": NOW_COLOR, "size": 10},
-        cliponaxis=False,
-        name="now",
-        hovertemplate="t = %{x:.4g} s<br>E = %{y:.8g} J<extra></extra>",
-    )
-    return line, marker
-
-
-def _layout(fig, title: str, times, world: np.ndarray, arrows, energy_range) -> None:
-    """Title, equal-aspect 3D axes over the whole run, the energy axes, sizes."""
-    points = [world.reshape(-1, 3)]
-    for line, cone in arrows:
-        points += [np.column_stack([line["x"], line["y"], line["z"]])]
-        points += [np.column_stack([cone["x"], cone["y"], cone["z"]])]
-    points = np.concatenate(points)
-    points = points[np.all(np.isfinite(points), axis=1)]
-    if len(points) == 0:
-        points = np.zeros((1, 3))
-    low, high = points.min(axis=0), points.max(axis=0)
-    half = 0.55 * float(np.max(high - low)) or 1.0
-    center = 0.5 * (low + high)
-    axes = {
-        f"{name}axis": {
-            "title": {"text": f"{name} (m)"},
-            "range": [c - half, c + half],
-            "nticks": 8,
-        }
-        for name, c in zip("xyz", center, strict=True)
-    }
-    fig.update_layout(
-        title={"text": html.escape(title).replace("\n", "<br>"), "x": 0.5, "xanchor": "center"},
-        height=850 + 20 * title.count("\n"),
-        margin={"l": 60, "r": 30, "t": 60 + 20 * title.count("\n"), "b": 50},
-        showlegend=False,
-        uirevision="tumble",
-        scene={
-            **axes,
-            "domain": {"y": [SCENE_BOTTOM, 1.0]},
-            "aspectmode": "cube",
-            "camera": {"eye": {"x": 1.5, "y": 1.5, "z": 1.1}},
-        },
-        xaxis={"title": {"text": "t (s)"}, "range": [float(times[0]), float(times[-1])]},
-        yaxis={
-            "title": {"text": "kinetic energy (J)"},
-            "range": energy_range,
-            "domain": [0.0, ENERGY_TOP],
-            "exponentformat": "e",
-        },
-    )
-
-
-def _controls(names: list[str], times: np.ndarray) -> dict:
-    """The Play/Pause buttons and the time slider (labels in s) of the animation."""
-    spacing = (times[-1] - times[0]) / max(len(times) - 1, 1)
-    decimals = max(0, int(np.ceil(-np.log10(spacing / 5)))) if spacing > 0 else 3
-    duration = int(np.clip(1000 * spacing, *FRAME_DURATION_MS))
-    still = {"mode": "immediate", "frame": {"duration": 0, "redraw": True}}
-    still["transition"] = {"duration": 0}
-    play = {**still, "frame": {"duration": duration, "redraw": True}, "fromcurrent": True}
-    pause = {**still, "frame": {"duration": 0, "redraw": False}}
-    steps = [
-        {"method": "animate", "label": f"{time:.{decimals}f}", "args": [[name], still]}
-        for name, time in zip(names, times, strict=True)
-    ]
-    return {
-        "updatemenus": [
-            {
-                "type": "buttons",
-                "direction": "left",
-                "x": 0.0,
-                "y": SLIDER_TOP,
-                "xanchor": "left",
-                "yanchor": "top",
-                "pad": {"t": 45, "r": 10},
-                "showactive": False,
-                "buttons": [
-                    {"label": "▶ Play", "method": "animate", "args": [None, play]},
-                    {"label": "❚❚ Pause", "method": "animate", "args": [[None], pause]},
-                ],
-            }
-        ],
-        "sliders": [
-            {
-                "active": 0,
-                "x": 0.17,
-                "y": SLIDER_TOP,
-                "len": 0.83,
-                "xanchor": "left",
-                "yanchor": "top",
-                "pad": {"t": 10, "b": 10},
-                "currentvalue": {"prefix": "t = ", "suffix": " s", "visible": True},
-                "steps": steps,
-            }
-        ],
-    }
+__all__ = [
+    "ARROW_COLOR",
+    "ARROW_LENGTH",
+    "DEFAULT_FRAMES",
+    "DIV_ID",
+    "ENERGY_POINTS",
+    "ENERGY_TOP",
+    "FRAME_DURATION_MS",
+    "IMPULSE_WINDOW_FRAMES",
+    "MESH_COLOR",
+    "NOW_COLOR",
+    "SCENE_BOTTOM",
+    "SHARP_EDGE_DEGREES",
+    "SLIDER_TOP",
+    "display_mesh",
+    "frame_indices",
+    "html_viewer",
+    "viewer_figure",
+]

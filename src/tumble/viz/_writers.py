@@ -1,0 +1,126 @@
+"""Writing animation frames to a file: a GIF through Pillow or an MP4 through ``ffmpeg``.
+
+The format comes from the path's suffix alone (:func:`animation_format`), so a temporary
+name such as ``.animation.partial.gif`` works. A GIF gets one palette for all frames
+(:data:`GIF_COLOURS` colours, the load arrows' :data:`LOAD_COLOURS` kept exact), so pixels
+that do not change cost nothing; an MP4 is H.264 in yuv420p and needs ``ffmpeg`` on ``PATH``
+(:func:`mp4_available`).
+
+Private: :mod:`tumble.viz.animation` re-exports :func:`mp4_available`,
+:func:`animation_format` and :func:`write_animation`, and draws the frames
+(:func:`tumble.viz.structural.beam_animation` uses the same writers). Pillow and matplotlib
+are imported inside the functions that use them.
+
+Examples
+--------
+>>> animation_format("run/.animation.partial.gif")
+'gif'
+"""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+FORMATS = (".gif", ".mp4")
+"""Suffixes the animation writers accept."""
+GIF_COLOURS = 64
+"""Palette size of a GIF (80 frames of 480 × 480 px come to about 0.5–1 MB)."""
+LOAD_COLOURS = {"impulse": "tab:red", "force": "tab:orange"}
+"""Colours of the load arrows (matplotlib names); a GIF's palette holds them exactly."""
+
+
+def mp4_available() -> bool:
+    """Whether ``ffmpeg`` is on ``PATH`` (needed to write ``.mp4``)."""
+    return shutil.which("ffmpeg") is not None
+
+
+def animation_format(path: str | Path) -> str:
+    """The format ``"gif"`` or ``"mp4"`` for ``path``, from its suffix only.
+
+    Raises
+    ------
+    ValueError
+        If the suffix is neither ``.gif`` nor ``.mp4``.
+    RuntimeError
+        If it is ``.mp4`` and ``ffmpeg`` is not on ``PATH``.
+    """
+    suffix = Path(path).suffix.lower()
+    if suffix not in FORMATS:
+        raise ValueError(
+            f"path={str(path)!r} has suffix {suffix!r}; an animation is written as one of "
+            f"{list(FORMATS)}"
+        )
+    if suffix == ".mp4" and not mp4_available():
+        raise RuntimeError(
+            f"path={str(path)!r}: writing .mp4 needs ffmpeg on PATH; install it "
+            "(e.g. apt-get install ffmpeg) or write a .gif"
+        )
+    return suffix[1:]
+
+
+def write_animation(images: Sequence[NDArray], path: str | Path, *, fps: float = 20) -> Path:
+    """Write RGB frames (each shape (height, width, 3), uint8) as a GIF or an MP4.
+
+    GIF: Pillow, looping, every frame mapped (no dithering) onto one palette of
+    :data:`GIF_COLOURS` colours: the median cut of all frames (every fourth pixel), plus the
+    load arrows' colours, which are too few pixels to survive the cut. MP4: ffmpeg, H.264 in
+    yuv420p (odd sizes padded by one pixel). The format comes from the suffix of ``path``
+    only (:func:`animation_format`).
+
+    Returns
+    -------
+    Path
+        ``path``.
+    """
+    kind = animation_format(path)
+    fps = check_positive("fps", fps)
+    if len(images) == 0:
+        raise ValueError("images is empty; pass at least one frame")
+    path = Path(path)
+    if kind == "gif":
+        from PIL import Image
+
+        palette = _gif_palette(images)
+        frames = [
+            Image.fromarray(image).quantize(palette=palette, dither=Image.Dither.NONE)
+            for image in images
+        ]
+        frames[0].save(path, format="GIF", save_all=True, append_images=frames[1:],
+                       duration=round(1000 / fps), loop=0, optimize=True)  # fmt: skip
+        return path
+    height, width = images[0].shape[:2]
+    command = ["ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
+               "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
+               "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
+               "-pix_fmt", "yuv420p", "-f", "mp4", str(path)]  # fmt: skip
+    data = b"".join(np.ascontiguousarray(image, dtype=np.uint8).tobytes() for image in images)
+    result = subprocess.run(command, input=data, capture_output=True, check=False)
+    if result.returncode != 0:
+        raise RuntimeError(f"ffmpeg failed writing {str(path)!r}: {result.stderr.decode()}")
+    return path
+
+
+def _gif_palette(images: Sequence[NDArray]):
+    """One palette image for every frame (see :func:`write_animation`)."""
+    from matplotlib.colors import to_rgb
+    from PIL import Image
+
+    mosaic = Image.fromarray(np.concatenate([image[::4, ::4] for image in images], axis=0))
+    reserved = [round(255 * c) for colour in LOAD_COLOURS.values() for c in to_rgb(colour)]
+    cut = mosaic.quantize(GIF_COLOURS - len(LOAD_COLOURS), dither=Image.Dither.NONE)
+    palette = Image.new("P", (1, 1))
+    palette.putpalette(cut.getpalette()[: 3 * (GIF_COLOURS - len(LOAD_COLOURS))] + reserved)
+    return palette
+
+
+def check_positive(name: str, value: object) -> float:
+    """``value`` as a float; a :class:`ValueError` naming ``name`` unless it is a number > 0."""
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise ValueError(f"{name}={value!r} must be a positive number")
+    return float(value)
