@@ -10,7 +10,9 @@ Time stepping
     :func:`integrate` with a scheme from :data:`SCHEMES` — ``explicit``,
     ``semi-implicit``, ``implicit``, ``midpoint`` (the seed's four) and ``newmark``
     (:class:`Newmark`, average acceleration by default) — returns a :class:`Response`
-    (``t``, ``x``, ``y``, ``energy``, ``tip_displacement``).
+    (``t``, ``x``, ``y``, ``energy``, ``tip_displacement``). The step matrix is factorised
+    once, banded Cholesky or sparse LU by its band (:mod:`tumble.structural.factorization`),
+    and the loop runs compiled (:mod:`tumble.structural.stepping`).
 Stability
     :func:`critical_dt` (a :class:`CriticalStep`: the step, ``ω_max`` and whether that mode
     is axial or bending), :func:`stability_sweep` (energy growth per dt),

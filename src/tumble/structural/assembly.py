@@ -9,7 +9,7 @@ Conditioning. ``κ(S)`` of a beam grows like ``N⁴`` with the element count (2.
 2.0e17 at N = 100, 1000, 10000 on the 1 m steel cantilever, measured), so in double
 precision a static solve loses about ``log10 κ`` digits: with SuperLU's default ordering
 the tip deflection was good to 2e-10 at N = 100, 5e-7 at N = 1000 and 15 % off at
-N = 10000 (0.3 % with :func:`~tumble.structural.system.factorize`'s symmetric ordering).
+N = 10000 (0.3 % with :func:`~tumble.structural.factorization.factorize`'s symmetric ordering).
 The builder estimates ``κ(S)`` and warns with :class:`IllConditionedWarning` when
 ``ε κ(S) > 1`` (from about 3700 elements on this beam), i.e. when round-off alone can
 exceed the displacement itself; at N = 10⁵ even the time stepping blows up.
@@ -31,7 +31,8 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from tumble.structural import elements, validation
-from tumble.structural.system import FrameElements, LinearSystem, factorize
+from tumble.structural.factorization import factorize
+from tumble.structural.system import FrameElements, LinearSystem
 
 SUPPORT_KINDS: dict[str, tuple[bool, bool, bool]] = {
     "clamped": (True, True, True),

@@ -27,12 +27,18 @@ factorised once:
     Δx = Δt\\,(y^n + θ_y Δy),
 
 with ``r^n = f − S x^n − C y^n``. :class:`Newmark` (average acceleration by default) is the
-same kind of step. Every scheme is written *in increments*: the internal force ``S x`` is
-carried along and updated by ``S Δx`` computed element by element, never recomputed as
-``S x`` from the global matrix. On fine meshes (``κ(S) ∝ N⁴``) that keeps the midpoint
-tip deflection within 8e-4 (of ``F L³/3EI``) of a converged 100-element run over 2000
-steps at N = 10000, where the seed's plain form (``b = M y + Δt (f − S x)`` each step) is
-off by 195 % and increments with a global ``S Δx`` by 193 % (measured).
+same kind of step. Every scheme is written *in increments* (:mod:`tumble.structural.stepping`):
+the out-of-balance force ``f − S x`` is carried along and updated by ``S Δx`` computed
+element by element, never recomputed from the global matrix. On fine meshes
+(``κ(S) ∝ N⁴``) that keeps the midpoint tip deflection within 1.1e-4 (of ``F L³/3EI``) of
+a converged 100-element run over 2000 steps at N = 10000, where the seed's plain form
+(``b = M y + Δt (f − S x)`` each step) is off by 195 % and increments with a global
+``S Δx`` by 193 % (measured).
+
+:func:`integrate` factorises the constant matrix once — banded Cholesky when its band is
+narrow (every beam, and every frame numbered along its members or renumbered by reverse
+Cuthill–McKee), sparse LU otherwise (:mod:`tumble.structural.factorization`) — and with the
+banded factor runs the whole time loop compiled (:func:`tumble.structural.kernels.run_steps`).
 
 References
 ----------
@@ -54,12 +60,16 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
-from tumble.structural import validation
-from tumble.structural.kernels import all_finite
-from tumble.structural.system import LinearSystem, RayleighDamping, factorize
+from tumble.structural import stepping, validation
+from tumble.structural.factorization import MAX_BANDWIDTH, band_structure, banded_cholesky
+from tumble.structural.stepping import Increments, State
+from tumble.structural.system import LinearSystem, RayleighDamping
 
 PROGRESS_UPDATES = 200
 """A progress bar is advanced about this many times per run."""
+
+BLOCK_WORK = 2**24
+"""Without a progress bar the compiled loop takes about this many DOF-steps per call."""
 
 
 @dataclass(frozen=True)
@@ -79,6 +89,10 @@ class ThetaScheme:
         """The constant matrix ``M + θ_y Δt C + θ_x θ_y Δt² S``."""
         A = system.M + (self.theta_x * self.theta_y * dt * dt) * system.S
         return A if C is None else A + (self.theta_y * dt) * C
+
+    def increments(self, dt: float) -> Increments:
+        """``k_g = θ_x Δt``, ``k_dy = θ_y Δt``: ``Δx = Δt (yⁿ + θ_y Δy)``."""
+        return Increments(dt, self.theta_x * dt, self.theta_y * dt)
 
 
 @dataclass(frozen=True)
@@ -121,6 +135,17 @@ class Newmark:
         A = system.M + (self.beta * dt * dt) * system.S
         return A if C is None else A + (self.gamma * dt) * C
 
+    def increments(self, dt: float) -> Increments:
+        """The constants of the equations above; the ``aⁿ`` terms vanish when ``2β = γ``."""
+        beta, gamma = self.beta, self.gamma
+        return Increments(
+            dt,
+            k_g=gamma * dt,
+            k_dy=beta / gamma * dt,
+            k_sa=(gamma / 2 - beta) * dt * dt,
+            k_a=(0.5 - beta / gamma) * dt * dt,
+        )
+
 
 EXPLICIT = ThetaScheme("explicit", 0.0, 0.0, "almost explicit")
 SEMI_IMPLICIT = ThetaScheme("semi-implicit", 0.0, 1.0, "semi-implicit")
@@ -162,6 +187,10 @@ class Response:
         record is then that step's state.
     message : str
         What happened, with the time.
+    solver : str
+        How the steps were solved: ``"banded-cholesky"`` (the compiled loop) or
+        ``"sparse-lu"`` (the NumPy reference loop); see :func:`integrate`. Empty if
+        unknown (a response built elsewhere).
     """
 
     t: NDArray[np.float64]
@@ -173,6 +202,7 @@ class Response:
     tip_dof: int
     status: str
     message: str
+    solver: str = ""
 
     @property
     def tip_displacement(self) -> NDArray[np.float64]:
@@ -183,67 +213,6 @@ class Response:
     def success(self) -> bool:
         """True unless the run diverged."""
         return self.status == "ok"
-
-
-@dataclass
-class _State:
-    """The stepped state; ``f_int`` is ``S x`` kept up to date by increments."""
-
-    x: NDArray[np.float64]
-    y: NDArray[np.float64]
-    f_int: NDArray[np.float64]
-
-
-Step = Callable[[_State], None]
-
-
-def theta_step(
-    scheme: ThetaScheme, system: LinearSystem, dt: float, C: sp.spmatrix | None
-) -> Step:
-    """One step of a :class:`ThetaScheme`, with its matrix factorised once (module docstring)."""
-    solve = factorize(scheme.matrix(system, C, dt))
-    f, forces, work = system.f, system.internal_forces, np.empty(system.n_dofs)
-    theta_x, theta_y = scheme.theta_x, scheme.theta_y
-
-    def step(state: _State) -> None:
-        r = f - state.f_int
-        if C is not None:
-            r -= C @ state.y
-        if theta_x:
-            r -= (theta_x * dt) * forces(state.y, work)
-        dy = solve(dt * r)
-        dx = dt * (state.y + theta_y * dy) if theta_y else dt * state.y
-        state.y += dy
-        state.x += dx
-        state.f_int += forces(dx, work)
-
-    return step
-
-
-def newmark_step(scheme: Newmark, system: LinearSystem, dt: float, C: sp.spmatrix | None) -> Step:
-    """One :class:`Newmark` step in velocity increments, its matrix factorised once."""
-    beta, gamma = scheme.beta, scheme.gamma
-    solve = factorize(scheme.matrix(system, C, dt))
-    solve_mass = factorize(system.M) if 2 * beta != gamma else None
-    f, forces, work = system.f, system.internal_forces, np.empty(system.n_dofs)
-
-    def step(state: _State) -> None:
-        r = f - state.f_int
-        if C is not None:
-            r -= C @ state.y
-        rhs = r - (gamma * dt) * forces(state.y, work)
-        dx = dt * state.y
-        if solve_mass is not None:
-            a = solve_mass(r)
-            rhs -= ((gamma / 2 - beta) * dt * dt) * forces(a, work)
-            dx += ((0.5 - beta / gamma) * dt * dt) * a
-        dy = solve(dt * rhs)
-        dx += (beta / gamma * dt) * dy
-        state.y += dy
-        state.x += dx
-        state.f_int += forces(dx, work)
-
-    return step
 
 
 def resolve_scheme(scheme: str | Scheme) -> Scheme:
@@ -265,11 +234,16 @@ def integrate(
     damping: RayleighDamping | None = None,
     record_every: int = 1,
     progress: bool = False,
+    compiled: bool | None = None,
 ) -> Response:
     """Step ``M ẍ + C ẋ + S x = f`` from ``(x0, y0)`` with a fixed time step.
 
-    The scheme's constant matrix is factorised once; a step then costs O(n_dofs): one
-    sparse triangular solve and one or two element-level internal-force sums.
+    The scheme's constant matrix is factorised once, by its structure
+    (:func:`~tumble.structural.factorization.band_structure`): banded Cholesky when the
+    band is narrow, and then the whole loop runs compiled
+    (:func:`~tumble.structural.kernels.run_steps`), a step costing one banded solve and
+    one pass over the elements; otherwise SuperLU and the NumPy reference loop
+    (:mod:`tumble.structural.stepping`).
 
     Parameters
     ----------
@@ -288,14 +262,21 @@ def integrate(
     damping : RayleighDamping, optional
         ``C = α M + β S``; none by default.
     record_every : int, optional
-        Record every this many steps (the last step is always recorded).
+        Record every this many steps (the last step is always recorded); memory is
+        ``2 n_dofs`` numbers per record.
     progress : bool, optional
         Show a ``rich`` progress bar.
+    compiled : bool, optional
+        Force (True) or forbid (False) the banded Cholesky and the compiled loop; by
+        default they run when the band is narrow and the Cholesky completes (it can
+        break down when ``κ(A) > 1/ε``, e.g. a 10⁵-element cantilever; SuperLU then
+        steps). ``False`` runs the NumPy reference.
 
     Returns
     -------
     Response
         ``status == "diverged"`` if the state became non-finite; the run stops there.
+        ``solver`` says which path ran.
 
     Examples
     --------
@@ -304,6 +285,8 @@ def integrate(
     >>> run = integrate(beam, "midpoint", dt=1e-4, n_steps=1000)
     >>> run.x.shape, bool(np.abs(run.energy).max() < 1e-12 * 0.5 * 1.0 / (3 * 175))
     ((1001, 20), True)
+    >>> run.solver
+    'banded-cholesky'
     """
     scheme = resolve_scheme(scheme)
     dt = validation.time_step(dt)
@@ -311,32 +294,45 @@ def integrate(
     record_every = validation.count("record_every", record_every)
     state = _initial_state(system, x0, y0)
     C = None if damping is None else damping.matrix(system)
-    make = theta_step if isinstance(scheme, ThetaScheme) else newmark_step
-    step = make(scheme, system, dt, C)  # type: ignore[arg-type]
+    run, factor, solver = _choose_loop(scheme.matrix(system, C, dt), compiled)
     steps = np.unique(np.r_[np.arange(0, n_steps + 1, record_every), n_steps])
-    xs, ys = np.empty((steps.size, system.n_dofs)), np.empty((steps.size, system.n_dofs))
-    xs[0], ys[0] = state.x, state.y
-    row, status, message = 1, "ok", f"{n_steps} steps of {dt:g} s"
-    every = max(1, n_steps // PROGRESS_UPDATES)
+    block = stepping.block_size(n_steps, PROGRESS_UPDATES if progress else 1)
+    if not progress:  # one call per ~BLOCK_WORK DOF-steps: Ctrl-C is seen between calls
+        block = min(block, max(1, BLOCK_WORK // system.n_dofs))
     with _progress_bar(progress, n_steps, scheme.name) as advance, _quiet_overflow():
-        for k in range(1, n_steps + 1):
-            step(state)
-            if not all_finite(state.x, state.y):
-                steps[row] = k
-                xs[row], ys[row], row = state.x, state.y, row + 1
-                status = "diverged"
-                message = f"the state became non-finite at step {k} (t = {k * dt:.6g} s)"
-                break
-            if k == steps[row]:
-                xs[row], ys[row], row = state.x, state.y, row + 1
-            if k % every == 0:
-                advance(every)
+        xs, ys, row, diverged = run(
+            system, scheme.increments(dt), factor, C, state, steps, advance, block
+        )
+    status, message = "ok", f"{n_steps} steps of {dt:g} s"
+    if diverged >= 0:
+        steps[row - 1] = diverged
+        status = "diverged"
+        message = f"the state became non-finite at step {diverged} (t = {diverged * dt:.6g} s)"
     xs, ys = xs[:row], ys[:row]
     with _quiet_overflow():
         energy = system.energy(xs, ys)
     return Response(
-        steps[:row] * dt, xs, ys, energy, scheme.name, dt, system.tip_dof, status, message
+        steps[:row] * dt, xs, ys, energy, scheme.name, dt, system.tip_dof, status, message, solver
     )
+
+
+def _choose_loop(A: sp.spmatrix, compiled: bool | None) -> tuple[Callable, object, str]:
+    """The compiled loop and a banded Cholesky of ``A``, or the reference loop and SuperLU."""
+    structure = band_structure(A)
+    if not (structure.narrow if compiled is None else compiled):
+        return stepping.reference_loop, A, "sparse-lu"
+    if structure.bandwidth > MAX_BANDWIDTH:
+        raise ValueError(
+            f"compiled=True needs a step matrix of half-bandwidth <= {MAX_BANDWIDTH}; this "
+            f"one has {structure.bandwidth} even after reverse Cuthill–McKee: leave "
+            "compiled=None to use the sparse LU"
+        )
+    try:
+        return stepping.compiled_loop, banded_cholesky(A, structure.order), "banded-cholesky"
+    except np.linalg.LinAlgError:  # κ(A) beyond 1/ε: a pivot came out <= 0
+        if compiled:
+            raise
+        return stepping.reference_loop, A, "sparse-lu"
 
 
 def _step_count(n_steps: int | None, t_end: float | None, dt: float) -> int:
@@ -350,15 +346,14 @@ def _step_count(n_steps: int | None, t_end: float | None, dt: float) -> int:
     return max(1, math.ceil(t_end / dt * (1 - 1e-12)))
 
 
-def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | None) -> _State:
+def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | None) -> State:
     start = []
     for name, value in (("x0", x0), ("y0", y0)):
         array = np.zeros(system.n_dofs) if value is None else validation.finite(name, value)
         if array.shape != (system.n_dofs,):
             raise ValueError(f"{name} must have shape ({system.n_dofs},); got {array.shape}")
         start.append(array.astype(float, copy=True))
-    x, y = start
-    return _State(x, y, system.internal_forces(x))
+    return State.start(system, *start)
 
 
 @contextmanager
