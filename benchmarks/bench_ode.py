@@ -44,7 +44,8 @@ def _row(name, tumble_case, scipy_case, error, repeat):
     )
 
 
-def main(argv: list[str] | None = None) -> None:
+def main(argv: list[str] | None = None) -> str:
+    """Print the table and return it as a markdown section (heading, table, notes)."""
     argv = sys.argv[1:] if argv is None else argv
     repeat = 3 if "--quick" in argv else 9
     v = 500 / np.sqrt(2)
@@ -84,10 +85,21 @@ def main(argv: list[str] | None = None) -> None:
                 repeat,
             )
         )
-    print(f"# bench_ode — {machine()}; numpy {np.__version__}, scipy {scipy.__version__}")
-    print("| problem | tumble ms, median (min–max) | error | scipy ms | error | scipy/tumble |")
-    print("|---|---|---|---|---|---|")
-    print("\n".join(rows))
+    markdown = "\n".join(
+        [
+            "## ODE core (`benchmarks/bench_ode.py`)",
+            "",
+            "| problem | tumble ms, median (min–max) | error | scipy ms | error | scipy/tumble |",
+            "|---|---|---|---|---|---|",
+            *rows,
+            "",
+            f"Same tolerances for both; ratio > 1: tumble faster. {machine()}; numpy "
+            f"{np.__version__}, scipy {scipy.__version__}.",
+            "",
+        ]
+    )
+    print(markdown)
+    return markdown
 
 
 if __name__ == "__main__":

@@ -14,6 +14,8 @@ Rigid bodies
 :func:`simulate`                    every rigid-body method through one entry point
 :class:`Gravity`, :class:`Force`    loads (also :class:`Torque`, :class:`Impulse`)
 :class:`Trajectory`                 what ``simulate`` returns
+:func:`simulate_batch`              many bodies at once (compiled, parallel); a
+                                    :class:`BatchTrajectory`
 Modules
 :mod:`tumble.so3`                   rotations: exp/log, dexp, quaternions, Euler angles
 :mod:`tumble.mass`                  mass properties: primitives, composites, meshes
@@ -29,6 +31,7 @@ from tumble import exact, mass, meshes, so3, structural
 from tumble.ode import ButcherTableau, OdeResult, solve
 from tumble.rigid import (
     METHODS,
+    BatchTrajectory,
     Force,
     Gravity,
     Impulse,
@@ -36,6 +39,7 @@ from tumble.rigid import (
     Torque,
     Trajectory,
     simulate,
+    simulate_batch,
 )
 
 __version__ = "0.1.0"
@@ -45,6 +49,7 @@ logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 __all__ = [
     "METHODS",
+    "BatchTrajectory",
     "ButcherTableau",
     "Force",
     "Gravity",
@@ -57,6 +62,7 @@ __all__ = [
     "mass",
     "meshes",
     "simulate",
+    "simulate_batch",
     "so3",
     "solve",
     "structural",

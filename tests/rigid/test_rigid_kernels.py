@@ -51,3 +51,17 @@ def test_record_every_keeps_every_kth_step_and_the_last(body):
     run = simulate(body, 1.0, h=0.01, omega0=(1, 0, 0), record_every=30)
     np.testing.assert_allclose(run.t, [0.0, 0.3, 0.6, 0.9, 1.0], atol=1e-14)
     assert run.n_steps == 100
+
+
+@pytest.mark.parametrize("h", [0.08, 0.3], ids=["series-edge", "sin-cos"])
+@pytest.mark.parametrize("method", ["lie-euler", "seed-rk4", "rkmk4"])
+def test_kernel_matches_reference_for_large_rotations_per_step(body, method, h):
+    # |ω| ≈ 2.7 rad/s: h = 0.08 turns ≈ 0.22 rad per step, near the end of the kernels'
+    # Taylor series for exp and dexp⁻¹ (kernels.SERIES_ANGLE = 0.25), where their truncation
+    # matters most; h = 0.3 turns ≈ 0.8 rad, on their sin/cos branch. The test above stays at
+    # 0.01 rad.
+    options = dict(method=method, h=h, omega0=(1.0, 2.0, -1.5), forces=FORCES[:2])
+    reference = simulate(body, 3.0, compiled=False, **options)
+    kernel = simulate(body, 3.0, compiled=True, **options)
+    np.testing.assert_allclose(kernel.R, reference.R, rtol=0, atol=1e-13)
+    np.testing.assert_allclose(kernel.L_world, reference.L_world, rtol=0, atol=1e-13)

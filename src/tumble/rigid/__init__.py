@@ -3,12 +3,14 @@
 =========================  ===================================================================
 :class:`RigidBody`         mass and inertia about the centre of mass (body axes)
 :func:`simulate`           one entry point for every method; returns a :class:`Trajectory`
+:func:`simulate_batch`     many bodies in one compiled, parallel call; a :class:`BatchTrajectory`
 :class:`Gravity` …         loads: :class:`Force`, :class:`Torque`, :class:`Impulse`
 :data:`METHODS`            ``euler``, ``lie-euler``, ``rk4-matrix``, ``rk4-quat``,
                            ``seed-rk4``, ``rkmk4``, ``rkmk45``
 =========================  ===================================================================
 """
 
+from tumble.rigid.batch import BatchTrajectory, simulate_batch
 from tumble.rigid.body import RigidBody
 from tumble.rigid.forces import Force, Gravity, Impulse, State, Torque
 from tumble.rigid.methods import METHODS, Method
@@ -17,6 +19,7 @@ from tumble.rigid.trajectory import Trajectory
 
 __all__ = [
     "METHODS",
+    "BatchTrajectory",
     "Force",
     "Gravity",
     "Impulse",
@@ -26,4 +29,5 @@ __all__ = [
     "Torque",
     "Trajectory",
     "simulate",
+    "simulate_batch",
 ]

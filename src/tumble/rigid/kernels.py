@@ -1,13 +1,30 @@
 """Compiled (numba) fixed-step loops: the same algorithm as :mod:`tumble.rigid.steppers`.
 
-One kernel runs every fixed-step method for constant loads: a stage loop over the tableau
-(``A``, ``b``, ``c`` as arrays), the family's vector field in a chart, and the family's map
-back (``R_n exp(û)``, quaternion renormalisation, or nothing). No allocation happens inside
-the step loop; every work array is made once per call. ``tests/rigid`` checks that kernel and
-reference agree to round-off.
+One loop, :func:`run_fixed`, runs every fixed-step method for constant loads: a stage loop
+over the tableau (``A``, ``b`` as arrays), the family's vector field in a chart, and the
+family's map back. A family is three compiled functions (field, advance, record), and
+:func:`_compile_loop` compiles the loop once per family with that family's functions inlined
+(the other families' branches are dropped at compile time):
 
-Families: 0 = matrix (``z = (vec R, x, p, L)``), 1 = quat (``z = (q, x, p, L)``),
-2 = lie (``z = (u, x, p, L)`` with ``R = R_n exp(û)``).
+=========  ==========================  ==========================  ===========================
+family     ``z``                       vector field                map back
+=========  ==========================  ==========================  ===========================
+matrix     ``(vec R, x, p, L)``        ``Ṙ = R ω̂``                 nothing
+quat       ``(q, x, p, L)``            ``q̇ = ½ q ⊗ (0, ω)``        ``q ← q/|q|``
+lie        ``(u, x, p, L)``            ``u̇ = dexp⁻¹_{−u}(ω)``      ``R_n ← R_n exp(û)``, u ← 0
+=========  ==========================  ==========================  ===========================
+
+with ``ω = I⁻¹ Rᵀ L``, ``ẋ = p/m``, ``ṗ = F``, ``L̇ = τ + Σ (R r_k) × f_k``.
+
+Why it is fast: the fields work on scalar locals; nothing is allocated inside the step loop
+(the work arrays are made once per call); the ``lie`` field never forms ``R = R_n exp(û)``, it
+needs only ``Rᵀ L = exp(−û) (R_nᵀ L)`` (Rodrigues' formula on one vector); and no array is
+passed into inlined code under a runtime branch, which costs numba an atomic reference-count
+update per array per stage (most of the time of the earlier version, which branched on the
+family inside one loop). The
+``exp`` and ``dexp⁻¹`` coefficients come from their Taylor series below :data:`SERIES_ANGLE`
+(accurate to round-off there, and free of the cancellation in ``1 − cos θ``). No fastmath:
+``tests/rigid`` checks that kernel and NumPy reference agree to round-off.
 """
 
 from __future__ import annotations
@@ -15,45 +32,80 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from tumble.ode.solve import fixed_step_count
 
-FAMILY_CODES = {"matrix": 0, "quat": 1, "lie": 2}
-_ATTITUDE_SIZE = (9, 4, 3)
-_SERIES_ANGLE = 1e-4
+SERIES_ANGLE = 0.25
+"""Below this angle (rad) the exp and dexp⁻¹ coefficients use their Taylor series; the first
+term left out is below 1e-17 relative (θ¹²/13! for sin θ/θ, 8e-19 for dexp⁻¹)."""
+
+_JIT = dict(cache=True, error_model="numpy")  # numpy error model: no ZeroDivisionError checks
+_INLINE = dict(_JIT, inline="always")
+_SERIES2 = SERIES_ANGLE * SERIES_ANGLE
+_S1, _S2, _S3, _S4, _S5 = -1.0 / 6, 1.0 / 120, -1.0 / 5040, 1.0 / 362880, -1.0 / 39916800
+_C1, _C2, _C3, _C4, _C5 = -1.0 / 24, 1.0 / 720, -1.0 / 40320, 1.0 / 3628800, -1.0 / 479001600
 
 
-@njit(cache=True)
-def _exp(u0, u1, u2, out):
-    """Rodrigues: ``out = exp(û) = I + sin θ/θ û + (1 − cos θ)/θ² û²``."""
-    theta2 = u0 * u0 + u1 * u1 + u2 * u2
-    theta = math.sqrt(theta2)
-    if theta < _SERIES_ANGLE:
-        a = 1.0 - theta2 / 6.0
-        b = 0.5 - theta2 / 24.0
-    else:
-        a = math.sin(theta) / theta
-        b = (1.0 - math.cos(theta)) / theta2
-    out[0, 0] = 1.0 - b * (u1 * u1 + u2 * u2)
-    out[1, 1] = 1.0 - b * (u0 * u0 + u2 * u2)
-    out[2, 2] = 1.0 - b * (u0 * u0 + u1 * u1)
-    out[0, 1] = -a * u2 + b * u0 * u1
-    out[1, 0] = a * u2 + b * u0 * u1
-    out[0, 2] = a * u1 + b * u0 * u2
-    out[2, 0] = -a * u1 + b * u0 * u2
-    out[1, 2] = -a * u0 + b * u1 * u2
-    out[2, 1] = a * u0 + b * u1 * u2
+@njit(**_JIT)
+def _exp_coefficients(theta2):
+    """``(sin θ/θ, (1 − cos θ)/θ²)`` for ``θ² = theta2``."""
+    x = theta2
+    if x < _SERIES2:  # Horner in θ²: Σ (−θ²)^k/(2k+1)! and Σ (−θ²)^k/(2k+2)!
+        a = 1.0 + x * (_S1 + x * (_S2 + x * (_S3 + x * (_S4 + x * _S5))))
+        b = 0.5 + x * (_C1 + x * (_C2 + x * (_C3 + x * (_C4 + x * _C5))))
+        return a, b
+    theta = math.sqrt(x)
+    half = math.sin(0.5 * theta) / theta
+    return math.sin(theta) / theta, 2.0 * half * half
 
 
-@njit(cache=True)
-def _matmul3(A, B, out):
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+@njit(**_JIT)
+def _dexpinv_coefficient(theta2):
+    """``α = (1 − (θ/2) cot(θ/2))/θ²``; Bernoulli series ``1/12 + θ²/720 + …`` when small."""
+    x = theta2
+    if x < _SERIES2:
+        tail = 1 / 1209600 + x * (1 / 47900160 + x * (691 / 1307674368000))  # 691/15!
+        return 1 / 12 + x * (1 / 720 + x * (1 / 30240 + x * tail))
+    theta = math.sqrt(x)
+    return 1.0 / x - (1.0 + math.cos(theta)) / (2.0 * theta * math.sin(theta))
 
 
-@njit(cache=True)
+@njit(**_JIT)
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(**_JIT)
+def _rotate(a, b, u0, u1, u2, v0, v1, v2):
+    """``v + a u×v + b u×(u×v)``: ``exp(û) v`` for exp's ``(a, b)``, ``exp(−û) v`` for
+    ``(−a, b)``, ``dexp⁻¹_{−u} v`` for ``(½, α)``."""
+    c0, c1, c2 = _cross(u0, u1, u2, v0, v1, v2)
+    d0, d1, d2 = _cross(u0, u1, u2, c0, c1, c2)
+    return v0 + a * c0 + b * d0, v1 + a * c1 + b * d1, v2 + a * c2 + b * d2
+
+
+@njit(**_JIT)
+def _apply(M, v0, v1, v2):
+    """``M v`` for a 3×3 ``M``."""
+    return (
+        M[0, 0] * v0 + M[0, 1] * v1 + M[0, 2] * v2,
+        M[1, 0] * v0 + M[1, 1] * v1 + M[1, 2] * v2,
+        M[2, 0] * v0 + M[2, 1] * v1 + M[2, 2] * v2,
+    )
+
+
+@njit(**_JIT)
+def _apply_transpose(M, v0, v1, v2):
+    """``Mᵀ v`` for a 3×3 ``M``."""
+    return (
+        M[0, 0] * v0 + M[1, 0] * v1 + M[2, 0] * v2,
+        M[0, 1] * v0 + M[1, 1] * v1 + M[2, 1] * v2,
+        M[0, 2] * v0 + M[1, 2] * v1 + M[2, 2] * v2,
+    )
+
+
+@njit(**_JIT)
 def _quat_matrix(q0, q1, q2, q3, out):
     """Rotation matrix of the unit quaternion ``(q0, q1, q2, q3)`` (scalar first)."""
     out[0, 0] = 1 - 2 * (q2 * q2 + q3 * q3)
@@ -67,160 +119,233 @@ def _quat_matrix(q0, q1, q2, q3, out):
     out[2, 2] = 1 - 2 * (q1 * q1 + q2 * q2)
 
 
-@njit(cache=True)
-def _omega(R, inv_I, L, out):
-    """``out = I⁻¹ Rᵀ L``."""
-    b0 = R[0, 0] * L[0] + R[1, 0] * L[1] + R[2, 0] * L[2]
-    b1 = R[0, 1] * L[0] + R[1, 1] * L[1] + R[2, 1] * L[2]
-    b2 = R[0, 2] * L[0] + R[1, 2] * L[1] + R[2, 2] * L[2]
-    for i in range(3):
-        out[i] = inv_I[i, 0] * b0 + inv_I[i, 1] * b1 + inv_I[i, 2] * b2
-
-
-@njit(cache=True)
-def _rates(z, off, R, m, F, tau, points, point_forces, out):
-    """``out[off:off+9] = (p/m, F, τ)`` for ``z[off:off+9] = (x, p, L)`` at attitude R."""
-    for i in range(3):
-        out[off + i] = z[off + 3 + i] / m
-        out[off + 3 + i] = F[i]
-        out[off + 6 + i] = tau[i]
+@njit(**_JIT)
+def _loads(off, zs, R, a, b, u0, u1, u2, m, F, tau, points, point_forces, K, i):
+    """``K[i, off:] = (p/m, F + Σ f_k, τ + Σ (R exp(û) r_k) × f_k)``, ``zs[off:] = (x, p, L)``."""
+    for c in range(3):
+        K[i, off + c] = zs[off + 3 + c] / m
+        K[i, off + 3 + c] = F[c]
+        K[i, off + 6 + c] = tau[c]
     for k in range(points.shape[0]):
-        r0 = R[0, 0] * points[k, 0] + R[0, 1] * points[k, 1] + R[0, 2] * points[k, 2]
-        r1 = R[1, 0] * points[k, 0] + R[1, 1] * points[k, 1] + R[1, 2] * points[k, 2]
-        r2 = R[2, 0] * points[k, 0] + R[2, 1] * points[k, 1] + R[2, 2] * points[k, 2]
+        r0, r1, r2 = _rotate(a, b, u0, u1, u2, points[k, 0], points[k, 1], points[k, 2])
+        r0, r1, r2 = _apply(R, r0, r1, r2)
         f0, f1, f2 = point_forces[k, 0], point_forces[k, 1], point_forces[k, 2]
-        out[off + 3] += f0
-        out[off + 4] += f1
-        out[off + 5] += f2
-        out[off + 6] += r1 * f2 - r2 * f1
-        out[off + 7] += r2 * f0 - r0 * f2
-        out[off + 8] += r0 * f1 - r1 * f0
+        t0, t1, t2 = _cross(r0, r1, r2, f0, f1, f2)
+        K[i, off + 3] += f0
+        K[i, off + 4] += f1
+        K[i, off + 5] += f2
+        K[i, off + 6] += t0
+        K[i, off + 7] += t1
+        K[i, off + 8] += t2
 
 
-@njit(cache=True)
-def _dexpinv_neg(u, w, out):
-    """``out[:3] = dexp⁻¹_{−u}(w) = w + ½ u×w + α u×(u×w)``, α = (1 − (θ/2)cot(θ/2))/θ²."""
-    theta2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2]
-    if theta2 < _SERIES_ANGLE * _SERIES_ANGLE:
-        alpha = 1.0 / 12.0 + theta2 / 720.0
-    else:
-        half = 0.5 * math.sqrt(theta2)
-        alpha = (1.0 - half * math.cos(half) / math.sin(half)) / theta2
-    c0 = u[1] * w[2] - u[2] * w[1]
-    c1 = u[2] * w[0] - u[0] * w[2]
-    c2 = u[0] * w[1] - u[1] * w[0]
-    out[0] = w[0] + 0.5 * c0 + alpha * (u[1] * c2 - u[2] * c1)
-    out[1] = w[1] + 0.5 * c1 + alpha * (u[2] * c0 - u[0] * c2)
-    out[2] = w[2] + 0.5 * c2 + alpha * (u[0] * c1 - u[1] * c0)
+# A family is three functions: field(correct, zs, Rn, R, inv_I, m, F, tau, points,
+# point_forces, K, i) writes K[i] = f(zs); advance(z, znew, Rn) sets z (and Rn) to the new
+# state; record(z, Rn, R_out, q_out, Y_out) writes one sample.
 
 
-@njit(cache=True)
-def _field(family, correct, zs, Rn, inv_I, m, F, tau, points, point_forces, out, R, E, w):
-    """The family's vector field at the stage value ``zs``; writes ``out``."""
-    if family == 0:
-        for i in range(3):
-            for j in range(3):
-                R[i, j] = zs[3 * i + j]
-        _omega(R, inv_I, zs[15:18], w)
-        for i in range(3):  # Ṙ = R ω̂
-            out[3 * i + 0] = R[i, 1] * w[2] - R[i, 2] * w[1]
-            out[3 * i + 1] = R[i, 2] * w[0] - R[i, 0] * w[2]
-            out[3 * i + 2] = R[i, 0] * w[1] - R[i, 1] * w[0]
-        _rates(zs, 9, R, m, F, tau, points, point_forces, out)
-    elif family == 1:
-        norm = math.sqrt(zs[0] ** 2 + zs[1] ** 2 + zs[2] ** 2 + zs[3] ** 2)
-        _quat_matrix(zs[0] / norm, zs[1] / norm, zs[2] / norm, zs[3] / norm, R)
-        _omega(R, inv_I, zs[10:13], w)
-        out[0] = 0.5 * (-zs[1] * w[0] - zs[2] * w[1] - zs[3] * w[2])  # ½ q ⊗ (0, ω)
-        out[1] = 0.5 * (zs[0] * w[0] + zs[2] * w[2] - zs[3] * w[1])
-        out[2] = 0.5 * (zs[0] * w[1] + zs[3] * w[0] - zs[1] * w[2])
-        out[3] = 0.5 * (zs[0] * w[2] + zs[1] * w[1] - zs[2] * w[0])
-        _rates(zs, 4, R, m, F, tau, points, point_forces, out)
-    else:
-        _exp(zs[0], zs[1], zs[2], E)
-        _matmul3(Rn, E, R)
-        _omega(R, inv_I, zs[9:12], w)
-        if correct:
-            _dexpinv_neg(zs, w, out)
-        else:
-            out[0], out[1], out[2] = w[0], w[1], w[2]
-        _rates(zs, 3, R, m, F, tau, points, point_forces, out)
+@njit(**_INLINE)
+def _lie_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i):
+    """``u̇ = dexp⁻¹_{−u}(ω)`` (``ω`` if not ``correct``), ``ω = I⁻¹ exp(−û) R_nᵀ L``."""
+    u0, u1, u2 = zs[0], zs[1], zs[2]
+    theta2 = u0 * u0 + u1 * u1 + u2 * u2
+    a, b = _exp_coefficients(theta2)
+    w0, w1, w2 = _apply_transpose(Rn, zs[9], zs[10], zs[11])
+    w0, w1, w2 = _apply(inv_I, *_rotate(-a, b, u0, u1, u2, w0, w1, w2))
+    half, alpha = (0.5, _dexpinv_coefficient(theta2)) if correct else (0.0, 0.0)
+    K[i, 0], K[i, 1], K[i, 2] = _rotate(half, alpha, u0, u1, u2, w0, w1, w2)
+    _loads(3, zs, Rn, a, b, u0, u1, u2, m, F, tau, points, point_forces, K, i)
 
 
-@njit(cache=True)
-def _record(family, z, Rn, R, count, t, rec_t, rec_R, rec_q, rec_Y):
-    rec_t[count] = t
-    if family == 0:
-        for i in range(3):
-            for j in range(3):
-                rec_R[count, i, j] = z[3 * i + j]
-    elif family == 1:
-        _quat_matrix(z[0], z[1], z[2], z[3], R)
-        rec_R[count] = R
-        rec_q[count] = z[:4]
-    else:
-        rec_R[count] = Rn
-    off = _offset(family)
-    rec_Y[count] = z[off : off + 9]
+@njit(**_INLINE)
+def _lie_advance(z, znew, Rn):
+    """``R_n ← R_n exp(û)`` (row r of the product is ``exp(−û)`` of row r), ``u ← 0``."""
+    u0, u1, u2 = znew[0], znew[1], znew[2]
+    a, b = _exp_coefficients(u0 * u0 + u1 * u1 + u2 * u2)
+    for r in range(3):
+        Rn[r, 0], Rn[r, 1], Rn[r, 2] = _rotate(-a, b, u0, u1, u2, Rn[r, 0], Rn[r, 1], Rn[r, 2])
+    z[0] = z[1] = z[2] = 0.0
+    for q in range(3, z.shape[0]):
+        z[q] = znew[q]
 
 
-@njit(cache=True)
-def _offset(family):
-    return 9 if family == 0 else (4 if family == 1 else 3)
+@njit(**_JIT)
+def _lie_record(z, Rn, R_out, q_out, Y_out):
+    R_out[:, :] = Rn
+    Y_out[:] = z[3:]
 
 
-@njit(cache=True)
-def _step_to(family, z, Rn, znew, E, Rtmp):
-    """Map the chart's new value back: ``R_n ← R_n exp(û)``, or ``q ← q/|q|``; then z ← znew."""
-    if family == 2:
-        _exp(znew[0], znew[1], znew[2], E)
-        _matmul3(Rn, E, Rtmp)
-        Rn[:, :] = Rtmp
-        znew[0] = znew[1] = znew[2] = 0.0
-    elif family == 1:
-        norm = math.sqrt(znew[0] ** 2 + znew[1] ** 2 + znew[2] ** 2 + znew[3] ** 2)
-        for i in range(4):
-            znew[i] /= norm
-    z[:] = znew
+@njit(**_INLINE)
+def _quat_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i):
+    """``q̇ = ½ q ⊗ (0, ω)``, ``ω = I⁻¹ Rᵀ L`` with ``R = R(q/|q|)``."""
+    q0, q1, q2, q3 = zs[0], zs[1], zs[2], zs[3]
+    norm = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
+    _quat_matrix(q0 / norm, q1 / norm, q2 / norm, q3 / norm, R)
+    w0, w1, w2 = _apply(inv_I, *_apply_transpose(R, zs[10], zs[11], zs[12]))
+    K[i, 0] = 0.5 * (-q1 * w0 - q2 * w1 - q3 * w2)
+    K[i, 1] = 0.5 * (q0 * w0 + q2 * w2 - q3 * w1)
+    K[i, 2] = 0.5 * (q0 * w1 + q3 * w0 - q1 * w2)
+    K[i, 3] = 0.5 * (q0 * w2 + q1 * w1 - q2 * w0)
+    _loads(4, zs, R, 0.0, 0.0, 0.0, 0.0, 0.0, m, F, tau, points, point_forces, K, i)
 
 
-@njit(cache=True)
-def run_fixed(family, correct, A, b, z, Rn, t_a, h, k0, k1, n, t_b, inv_I, m, F, tau,
-              points, point_forces, record_every, step0, rec_t, rec_R, rec_q, rec_Y):  # fmt: skip
+@njit(**_INLINE)
+def _quat_advance(z, znew, Rn):
+    """``q ← q/|q|``."""
+    norm = math.sqrt(znew[0] ** 2 + znew[1] ** 2 + znew[2] ** 2 + znew[3] ** 2)
+    for q in range(4):
+        z[q] = znew[q] / norm
+    for q in range(4, z.shape[0]):
+        z[q] = znew[q]
+
+
+@njit(**_JIT)
+def _quat_record(z, Rn, R_out, q_out, Y_out):
+    _quat_matrix(z[0], z[1], z[2], z[3], R_out)
+    q_out[:] = z[:4]
+    Y_out[:] = z[4:]
+
+
+@njit(**_INLINE)
+def _matrix_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i):
+    """``Ṙ = R ω̂``, ``ω = I⁻¹ Rᵀ L``, R the first nine numbers of ``zs``."""
+    for r in range(3):
+        for c in range(3):
+            R[r, c] = zs[3 * r + c]
+    w0, w1, w2 = _apply(inv_I, *_apply_transpose(R, zs[15], zs[16], zs[17]))
+    for r in range(3):
+        K[i, 3 * r + 0] = R[r, 1] * w2 - R[r, 2] * w1
+        K[i, 3 * r + 1] = R[r, 2] * w0 - R[r, 0] * w2
+        K[i, 3 * r + 2] = R[r, 0] * w1 - R[r, 1] * w0
+    _loads(9, zs, R, 0.0, 0.0, 0.0, 0.0, 0.0, m, F, tau, points, point_forces, K, i)
+
+
+@njit(**_INLINE)
+def _matrix_advance(z, znew, Rn):
+    for q in range(z.shape[0]):
+        z[q] = znew[q]
+
+
+@njit(**_JIT)
+def _matrix_record(z, Rn, R_out, q_out, Y_out):
+    for r in range(3):
+        for c in range(3):
+            R_out[r, c] = z[3 * r + c]
+    Y_out[:] = z[9:]
+
+
+def _compile_loop(family: int):
+    """The step loop of one family, compiled with that family's field and map back inlined.
+
+    ``family`` is a constant of the closure, so numba drops the other families' branches and
+    caches one loop per family (the cache is keyed by the closure's value).
+    """
+
+    @njit(**_JIT)
+    def loop(correct, A, b, z, Rn, t_a, h, k0, k1, n, t_b, inv_I, m, F, tau, points,
+             point_forces, every, step0, rec_t, rec_R, rec_q, rec_Y):  # fmt: skip
+        s, nz = b.shape[0], z.shape[0]
+        K, zs, R = np.empty((s, nz)), np.empty(nz), np.empty((3, 3))
+        count, until_record = 0, every - (step0 + k0) % every
+        for k in range(k0 + 1, k1 + 1):
+            t_old = t_a + (k - 1) * h
+            hk = (t_b if k == n else t_a + k * h) - t_old
+            for i in range(s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
+                for q in range(nz):
+                    acc = 0.0
+                    for j in range(i):
+                        acc += A[i, j] * K[j, q]
+                    zs[q] = z[q] + hk * acc
+                if family == 2:
+                    _lie_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i)
+                elif family == 1:
+                    _quat_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i)
+                else:
+                    _matrix_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i)
+            finite = True
+            for q in range(nz):  # z_new = z + h Σ b_i k_i
+                acc = 0.0
+                for i in range(s):
+                    acc += b[i] * K[i, q]
+                zs[q] = z[q] + hk * acc
+                finite = finite and math.isfinite(zs[q])
+            if not finite:
+                return count, k
+            if family == 2:
+                _lie_advance(z, zs, Rn)
+            elif family == 1:
+                _quat_advance(z, zs, Rn)
+            else:
+                _matrix_advance(z, zs, Rn)
+            until_record -= 1
+            if until_record == 0:
+                rec_t[count] = t_old + hk
+                if family == 2:
+                    _lie_record(z, Rn, rec_R[count], rec_q[count], rec_Y[count])
+                elif family == 1:
+                    _quat_record(z, Rn, rec_R[count], rec_q[count], rec_Y[count])
+                else:
+                    _matrix_record(z, Rn, rec_R[count], rec_q[count], rec_Y[count])
+                count += 1
+                until_record = every
+        return count, -1
+
+    return loop
+
+
+FAMILY_CODES = {"matrix": 0, "quat": 1, "lie": 2}
+ATTITUDE_SIZE = {"matrix": 9, "quat": 4, "lie": 3}
+_MATRIX_LOOP, _QUAT_LOOP, _LIE_LOOP = (_compile_loop(code) for code in range(3))
+LOOPS = {"matrix": _MATRIX_LOOP, "quat": _QUAT_LOOP, "lie": _LIE_LOOP}
+
+
+def run_fixed(family: str, *args):
     """Steps ``k0+1 … k1`` of the grid ``t_a + k h`` (step ``n`` lands on ``t_b``).
 
-    ``z`` (and ``Rn`` for the lie family) hold the state and are updated in place. A step is
-    recorded when ``step0 + k`` is a multiple of ``record_every``. Returns ``(recorded,
-    failed)`` with ``failed`` the step whose result was not finite, or -1.
+    ``args = (correct, A, b, z, Rn, t_a, h, k0, k1, n, t_b, inv_I, m, F, tau, points,
+    point_forces, every, step0, rec_t, rec_R, rec_q, rec_Y)``. Each step is one explicit
+    Runge–Kutta step of the family's chart (as :func:`tumble.ode.stepper.rk_step`)
+
+    .. math:: k_i = f\\Bigl(z + h \\sum_{j<i} a_{ij} k_j\\Bigr), \\quad
+              z_{n+1} = z + h \\sum_i b_i k_i,
+
+    then the family's map back. ``z`` (and ``Rn`` for the lie family) hold the state and are
+    updated in place. A step is recorded in ``rec_*`` when ``step0 + k`` is a multiple of
+    ``every``. Returns ``(recorded, failed)`` with ``failed`` the step whose result was not
+    finite, or -1.
     """
-    s, nz = b.shape[0], z.shape[0]
-    K, zs, znew = np.empty((s, nz)), np.empty(nz), np.empty(nz)
-    R, E, Rtmp, w = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3)), np.empty(3)
-    count = 0
-    for k in range(k0 + 1, k1 + 1):
-        t_old = t_a + (k - 1) * h
-        hk = (t_b if k == n else t_a + k * h) - t_old
-        for i in range(s):
-            for q in range(nz):
-                acc = 0.0
-                for j in range(i):
-                    acc += A[i, j] * K[j, q]
-                zs[q] = z[q] + hk * acc
-            _field(family, correct, zs, Rn, inv_I, m, F, tau, points, point_forces, K[i], R, E, w)
-        finite = True
-        for q in range(nz):
-            acc = 0.0
-            for i in range(s):
-                acc += b[i] * K[i, q]
-            znew[q] = z[q] + hk * acc
-            finite = finite and math.isfinite(znew[q])
-        if not finite:
-            return count, k
-        _step_to(family, z, Rn, znew, E, Rtmp)
-        if (step0 + k) % record_every == 0:
-            _record(family, z, Rn, R, count, t_old + hk, rec_t, rec_R, rec_q, rec_Y)
-            count += 1
-    return count, -1
+    return LOOPS[family](*args)
+
+
+@njit(**_JIT)
+def _run_body(family, correct, A, b, z, Rn, t_a, h, n, t_b, inv_I, m, F, tau, points,
+              point_forces, every, rec_t, rec_R, rec_q, rec_Y):  # fmt: skip
+    """All ``n`` steps of one body with the loop of ``family`` (a code of FAMILY_CODES)."""
+    args = (correct, A, b, z, Rn, t_a, h, 0, n, n, t_b, inv_I, m, F, tau, points,
+            point_forces, every, 0, rec_t, rec_R, rec_q, rec_Y)  # fmt: skip
+    if family == 2:
+        return _LIE_LOOP(*args)
+    if family == 1:
+        return _QUAT_LOOP(*args)
+    return _MATRIX_LOOP(*args)
+
+
+@njit(cache=True, error_model="numpy", parallel=True)
+def run_batch(family, correct, A, b, Z, RN, t_a, h, n, t_b, inv_I, m, F, tau, points,
+              point_forces, every, rec_t, rec_R, rec_q, rec_Y, counts, failed):  # fmt: skip
+    """:func:`run_fixed` over steps ``1 … n`` for every body ``k`` in parallel (``prange``).
+
+    ``family`` is a code of :data:`FAMILY_CODES`. Body ``k``'s state is ``Z[k]`` (and
+    ``RN[k]``), its inverse inertia ``inv_I[k]``, mass ``m[k]`` and centre-of-mass force
+    ``F[k]``; ``tau``, ``points`` and ``point_forces`` are shared. Its samples go to
+    ``rec_t[k]``, ``rec_R[k]``, …; ``counts[k]`` samples and the failed step ``failed[k]``
+    (-1 if none) come back.
+    """
+    for k in prange(Z.shape[0]):
+        counts[k], failed[k] = _run_body(
+            family, correct, A, b, Z[k], RN[k], t_a, h, n, t_b, inv_I[k], m[k], F[k], tau,
+            points, point_forces, every, rec_t[k], rec_R[k], rec_q[k], rec_Y[k],
+        )  # fmt: skip
 
 
 def pack(family: str, attitude: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -234,7 +359,7 @@ def unpack(family: str, z: np.ndarray, Rn: np.ndarray) -> tuple[np.ndarray, np.n
     """Inverse of :func:`pack`."""
     if family == "lie":
         return Rn.copy(), z[3:].copy()
-    size = _ATTITUDE_SIZE[FAMILY_CODES[family]]
+    size = ATTITUDE_SIZE[family]
     attitude = z[:size].reshape(3, 3) if family == "matrix" else z[:size]
     return attitude.copy(), z[size:].copy()
 
@@ -248,7 +373,7 @@ def run_segment(run, b: float, h: float, loads, advance) -> bool:
     """Integrate ``run`` from ``run.t`` to ``b`` with the kernel; False if it stopped."""
     F, tau, points, point_forces = loads
     family, method = run.method.family, run.method
-    code, A, weights = FAMILY_CODES[family], method.tableau.A, method.tableau.b
+    A, weights = method.tableau.A, method.tableau.b
     inv_I, every, a = run.dynamics.inertia_inverse, run.record_every, run.t
     n = fixed_step_count(a, b, h)
     z, Rn = pack(family, run.attitude, run.Y)
@@ -256,9 +381,10 @@ def run_segment(run, b: float, h: float, loads, advance) -> bool:
         size = (k1 - k0) // every + 1
         rec_t, rec_R = np.empty(size), np.empty((size, 3, 3))
         rec_q, rec_Y = np.empty((size, 4)), np.empty((size, 9))
-        count, failed = run_fixed(code, method.dexpinv, A, weights, z, Rn, a, h, k0, k1, n, b,
-                                  inv_I, run.dynamics.mass, F, tau, points, point_forces, every,
-                                  run.n_steps - k0, rec_t, rec_R, rec_q, rec_Y)  # fmt: skip
+        count, failed = run_fixed(family, method.dexpinv, A, weights, z, Rn, a, h,
+                                  k0, k1, n, b, inv_I, run.dynamics.mass, F, tau, points,
+                                  point_forces, every, run.n_steps - k0, rec_t, rec_R, rec_q,
+                                  rec_Y)  # fmt: skip
         q_block = rec_q[:count] if family == "quat" else None
         run.extend(rec_t[:count], rec_R[:count], rec_Y[:count], q_block)
         attitude, Y = unpack(family, z, Rn)

@@ -1,0 +1,494 @@
+"""``simulate_batch``: many bodies (or many initial states of one body) in one compiled call.
+
+Every body runs the same compiled loop as :func:`~tumble.rigid.simulate` (the kernels of
+:mod:`tumble.rigid.kernels`), one body per thread (numba ``prange``), so body ``k`` of a batch
+has the numbers of ``simulate`` run alone with body ``k``'s arguments. The initial states are
+checked and built for all bodies at once with NumPy (the same operations ``simulate`` applies
+to one body).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+
+from tumble import so3
+from tumble.ode.solve import fixed_step_count
+from tumble.rigid import initial
+from tumble.rigid.body import RigidBody
+from tumble.rigid.forces import compiled_loads, split_loads
+from tumble.rigid.kernels import FAMILY_CODES, run_batch
+from tumble.rigid.methods import METHODS, get_method
+from tumble.rigid.trajectory import Trajectory
+
+FIXED_METHODS = [name for name, method in METHODS.items() if not method.adaptive]
+"""The methods ``simulate_batch`` runs (every fixed-step method)."""
+
+
+@dataclass
+class BatchTrajectory:
+    """The trajectories of ``N`` bodies on one time grid; ``batch[k]`` is body ``k``'s.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Times (s), shared by every body.
+    x, v : ndarray, shape (N, n, 3)
+        Centre of mass (m) and its velocity (m/s), world frame.
+    R : ndarray, shape (N, n, 3, 3)
+        Attitude, body to world.
+    L_world : ndarray, shape (N, n, 3)
+        Angular momentum about the centre of mass, world frame (kg m²/s).
+    bodies : tuple of RigidBody
+        Body ``k`` of the batch (the same object ``N`` times when one body was given).
+    method : str
+        The method's name.
+    settings : dict
+        ``h``, ``record_every``, as :class:`~tumble.rigid.trajectory.Trajectory`'s.
+    status : ndarray of int, shape (N,)
+        0: reached ``t_end``; -1: stopped by a non-finite state (its later samples are NaN).
+    messages : list of str
+        What happened to each body.
+    n_steps : ndarray of int, shape (N,)
+        Steps taken by each body.
+    n_recorded : ndarray of int, shape (N,)
+        How many samples of each body are valid (all ``n`` unless it stopped early).
+    q_raw : ndarray, shape (N, n, 4), optional
+        The quaternions the ``quat`` method carried.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    v: np.ndarray
+    R: np.ndarray
+    L_world: np.ndarray
+    bodies: tuple[RigidBody, ...]
+    method: str
+    settings: dict = field(default_factory=dict)
+    status: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    messages: list[str] = field(default_factory=list)
+    n_steps: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    n_recorded: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    q_raw: np.ndarray | None = None
+
+    def __len__(self) -> int:
+        return len(self.bodies)
+
+    def __getitem__(self, k: int) -> Trajectory:
+        """Body ``k``'s :class:`~tumble.rigid.trajectory.Trajectory` (its valid samples)."""
+        k = range(len(self))[k]  # negative indices; IndexError out of range
+        n = int(self.n_recorded[k])
+        return Trajectory(
+            t=self.t[:n],
+            x=self.x[k, :n],
+            v=self.v[k, :n],
+            R=self.R[k, :n],
+            L_world=self.L_world[k, :n],
+            body=self.bodies[k],
+            method=self.method,
+            settings=dict(self.settings),
+            status=int(self.status[k]),
+            message=self.messages[k],
+            n_steps=int(self.n_steps[k]),
+            q_raw=None if self.q_raw is None else self.q_raw[k, :n],
+        )
+
+    @property
+    def success(self) -> np.ndarray:
+        """Per body: True unless it stopped on a non-finite state, shape (N,)."""
+        return self.status >= 0
+
+    @cached_property
+    def _inverse_inertia(self) -> np.ndarray:
+        return _per_body(self.bodies, lambda body: body.inertia_inverse)
+
+    @cached_property
+    def q(self) -> np.ndarray:
+        """Unit quaternions ``[w, x, y, z]`` with ``w ≥ 0``, shape (N, n, 4)."""
+        if self.q_raw is not None:
+            q = self.q_raw
+        else:
+            with np.errstate(invalid="ignore"):
+                U, _, Vt = np.linalg.svd(np.nan_to_num(self.R))  # nearest rotation
+                q = so3.quat_from_matrix(U @ Vt)
+            q[~np.isfinite(self.R).all(axis=(-1, -2))] = np.nan
+        return np.where(q[..., :1] < 0, -q, q)
+
+    @cached_property
+    def omega_body(self) -> np.ndarray:
+        """Body-frame angular velocity ``ω = I⁻¹ Rᵀ L``, shape (N, n, 3), rad/s."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            body_L = np.einsum("knji,knj->kni", self.R, self.L_world)
+            return body_L @ self._inverse_inertia.swapaxes(-1, -2)
+
+    @cached_property
+    def energy(self) -> np.ndarray:
+        """Kinetic energy ``½ m |v|² + ½ ω·(Rᵀ L)``, shape (N, n), J."""
+        mass = _per_body(self.bodies, lambda body: body.mass)[:, None]
+        with np.errstate(over="ignore", invalid="ignore"):  # a diverged body: inf, no warning
+            body_L = np.einsum("knji,knj->kni", self.R, self.L_world)
+            rotational = 0.5 * np.einsum("kni,kni->kn", self.omega_body, body_L)
+            return 0.5 * mass * np.einsum("kni,kni->kn", self.v, self.v) + rotational
+
+    @cached_property
+    def orthogonality_error(self) -> np.ndarray:
+        """``‖RᵀR − I‖_F`` at each sample, shape (N, n)."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            defect = np.einsum("knai,knaj->knij", self.R, self.R) - np.eye(3)
+            return np.linalg.norm(defect, axis=(-2, -1))
+
+    def to_xarray(self):
+        """An ``xarray.Dataset`` with dimensions ``(body, time, …)``.
+
+        The variables, units and attributes of :meth:`Trajectory.to_xarray
+        <tumble.rigid.trajectory.Trajectory.to_xarray>` with a leading ``body`` dimension, and
+        per body ``mass``, ``inertia``, ``status`` and ``message``.
+        """
+        return batch_dataset(self)
+
+
+def batch_dataset(batch: BatchTrajectory):
+    """Build :meth:`BatchTrajectory.to_xarray`'s dataset (the single-body layout + ``body``)."""
+    import xarray as xr
+
+    template = batch[0].to_xarray()  # names, dimensions, units and run attributes
+    data_vars = {
+        name: xr.Variable(("body", *var.dims), getattr(batch, name), attrs=var.attrs)
+        for name, var in template.data_vars.items()
+    }
+    data_vars["mass"] = xr.Variable("body", [b.mass for b in batch.bodies], {"units": "kg"})
+    inertia = np.array([b.inertia for b in batch.bodies])
+    data_vars["inertia"] = xr.Variable(("body", "row", "col"), inertia, {"units": "kg m2"})
+    data_vars["status"] = xr.Variable("body", batch.status)
+    data_vars["message"] = xr.Variable("body", np.array(batch.messages, dtype=str))
+    attrs = {k: v for k, v in template.attrs.items() if k not in ("mass", "inertia", "status")}
+    attrs.pop("message", None)
+    attrs["settings"] = json.dumps({k: v for k, v in batch.settings.items() if v is not None})
+    coords = {name: template.coords[name] for name in template.coords}
+    coords["time"] = ("time", batch.t, {"units": "s"})
+    coords["body"] = np.arange(len(batch))
+    return xr.Dataset(data_vars, coords=coords, attrs=attrs)
+
+
+def _per_body(bodies, value_of) -> np.ndarray:
+    """``value_of(body)`` for every body of the batch, evaluated once per distinct body.
+
+    Returned C-contiguous and read-only: the type the kernels take for a single body's data.
+    """
+    keys = list(map(id, bodies))
+    distinct = dict(zip(keys, bodies, strict=True))
+    values = {key: np.asarray(value_of(body), dtype=float) for key, body in distinct.items()}
+    if len(values) == 1:
+        (value,) = values.values()
+        stacked = np.broadcast_to(value, (len(bodies), *value.shape)).copy()
+    else:
+        stacked = np.array([values[key] for key in keys])
+    stacked.setflags(write=False)
+    return stacked
+
+
+def _bodies(body_or_bodies) -> tuple[list[RigidBody], bool]:
+    """The list of bodies and whether one body was given (to broadcast)."""
+    if isinstance(body_or_bodies, RigidBody):
+        return [body_or_bodies], True
+    if not isinstance(body_or_bodies, Sequence) or len(body_or_bodies) == 0:
+        raise ValueError(
+            f"body_or_bodies={body_or_bodies!r} must be a tumble.RigidBody or a non-empty "
+            "sequence of them"
+        )
+    for index, body in enumerate(body_or_bodies):
+        if not isinstance(body, RigidBody):
+            raise ValueError(f"body_or_bodies[{index}]={body!r} must be a tumble.RigidBody")
+    return list(body_or_bodies), False
+
+
+_ROW_SHAPES = {"x0": (3,), "v0": (3,), "R0": (3, 3), "q0": (4,), "omega0": (3,), "L0": (3,)}
+
+
+def _batch_size(bodies, one_body: bool, arrays: dict) -> tuple[int, str]:
+    """``N`` and where it came from: the bodies, or the first per-body array given."""
+    if not one_body:
+        return len(bodies), f"{len(bodies)} bodies"
+    for name, value in arrays.items():
+        if value is not None:
+            shape = np.shape(value)
+            if len(shape) != 1 + len(_ROW_SHAPES[name]) or shape[0] == 0:
+                expected = ", ".join(["N", *map(str, _ROW_SHAPES[name])])
+                raise ValueError(
+                    f"{name} has shape {shape}; simulate_batch expects ({expected}), one row "
+                    "per body (N ≥ 1)"
+                )
+            return shape[0], f"the first axis of {name}"
+    return 1, "one body and no per-body arrays"
+
+
+def _rows(value, name: str, n: int, source: str) -> np.ndarray | None:
+    """``value`` as a finite float array of shape ``(n, *row)``, or None."""
+    if value is None:
+        return None
+    array = np.asarray(value, dtype=float)
+    expected = (n, *_ROW_SHAPES[name])
+    if array.shape != expected:
+        raise ValueError(
+            f"{name} has shape {array.shape}; expected {expected}: one row per body "
+            f"(N = {n}, from {source})"
+        )
+    bad = ~np.isfinite(array.reshape(n, -1)).all(axis=1)
+    if bad.any():
+        raise ValueError(f"{name}[{int(np.argmax(bad))}] is not finite: {array[bad][0]!r}")
+    return array
+
+
+def _initial_states(bodies, R0, q0, omega0, L0, x0, v0, n: int):
+    """``(R, Y)`` of shapes (N, 3, 3) and (N, 9), as :func:`initial.initial_state` per body."""
+    if omega0 is not None and L0 is not None:
+        raise ValueError(
+            "give at most one of omega0 (body-frame angular velocity) and L0 (world angular "
+            "momentum); they describe the same thing"
+        )
+    if R0 is not None and q0 is not None:
+        raise ValueError("give at most one of R0 and q0 (both describe the initial attitude)")
+    if q0 is not None:
+        norm = np.linalg.norm(q0, axis=-1)
+        if np.any(norm == 0):
+            raise ValueError(
+                f"q0[{int(np.argmin(norm))}] has zero norm; a quaternion [w, x, y, z]"
+            )
+        R = so3.matrix_from_quat(q0 / norm[:, None])
+    elif R0 is not None:
+        R = so3.validate_rotation(R0, name="R0", atol=1e-9)
+    else:
+        R = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+    if L0 is not None:
+        L = L0.copy()
+    else:
+        omega = np.zeros((n, 3)) if omega0 is None else omega0
+        inertia = _per_body(bodies, lambda body: body.inertia)
+        L = (R @ (inertia @ omega[..., None]))[..., 0]
+    mass = _per_body(bodies, lambda body: body.mass)[:, None]
+    x = np.zeros((n, 3)) if x0 is None else x0
+    v = np.zeros((n, 3)) if v0 is None else v0
+    return R, np.concatenate([x, mass * v, L], axis=1)
+
+
+def _kernel_loads(forces, bodies):
+    """``(F (N, 3), tau, points, point_forces)`` for the constant loads; else a ValueError."""
+    loads, impulses = split_loads(forces)
+    if impulses or not all(load.compiled for load in loads):
+        raise ValueError(
+            "simulate_batch supports constant loads only: tumble.Gravity, and tumble.Force and "
+            "tumble.Torque with constant vectors; impulses and callable forces need "
+            "tumble.simulate (one body per call)"
+        )
+    F = _per_body(bodies, lambda body: compiled_loads(loads, body.mass)[0]).copy()
+    _, tau, points, point_forces = compiled_loads(loads, bodies[0].mass)
+    return F, tau, points, point_forces
+
+
+def _record_times(t0: float, t_end: float, h: float, n: int, every: int) -> np.ndarray:
+    """The kernel's sample times ``t_old + h_k`` at steps ``every, 2 every, …`` (exactly)."""
+    k = np.arange(every, n + 1, every)
+    t_old = t0 + (k - 1) * h
+    return t_old + (np.where(k == n, t_end, t0 + k * h) - t_old)
+
+
+def _check_record_every(record_every) -> int:
+    if not (isinstance(record_every, int | np.integer) and record_every >= 1):
+        raise ValueError(f"record_every={record_every!r} must be a positive integer")
+    return int(record_every)
+
+
+def simulate_batch(
+    body_or_bodies: RigidBody | Sequence[RigidBody],
+    t_end: float,
+    *,
+    method: str = "rkmk4",
+    h: float | None = None,
+    t0: float = 0.0,
+    x0=None,
+    v0=None,
+    R0=None,
+    q0=None,
+    omega0=None,
+    L0=None,
+    forces=(),
+    events=(),
+    record_every: int = 1,
+) -> BatchTrajectory:
+    """Simulate ``N`` rigid bodies from ``t0`` to ``t_end`` in one compiled, parallel call.
+
+    Each body obeys :func:`~tumble.rigid.simulate`'s equations,
+
+    .. math::
+
+        \\dot x = p/m,\\quad \\dot R = R\\,\\hat\\omega,\\quad \\dot p = F,\\quad
+        \\dot L = \\tau,\\qquad \\omega = I^{-1} R^T L,
+
+    and body ``k`` gets the numbers ``simulate`` gives it alone (same kernel, same steps).
+
+    Parameters
+    ----------
+    body_or_bodies : RigidBody or sequence of RigidBody
+        One body, run from ``N`` initial states (``N`` from the per-body arrays), or ``N``
+        bodies (different masses and inertias).
+    t_end : float
+        End time (s), > ``t0``; the last step lands on it.
+    method : str
+        A fixed-step method: ``"euler"``, ``"lie-euler"``, ``"rk4-matrix"``, ``"rk4-quat"``,
+        ``"seed-rk4"`` or ``"rkmk4"`` (default).
+    h : float
+        Step (s).
+    t0 : float
+        Start time (s).
+    x0, v0 : array_like, shape (N, 3), optional
+        Initial positions (m) and velocities (m/s); default 0.
+    R0 : array_like, shape (N, 3, 3), optional
+        Initial attitudes (rotation matrices), or
+    q0 : array_like, shape (N, 4), optional
+        as quaternions ``[w, x, y, z]``; default identity.
+    omega0 : array_like, shape (N, 3), optional
+        Initial body-frame angular velocities (rad/s), or
+    L0 : array_like, shape (N, 3), optional
+        world angular momenta (kg m²/s); default at rest.
+    forces : sequence
+        Constant loads, the same for every body: :class:`~tumble.Gravity` (``m g`` with each
+        body's mass), :class:`~tumble.Force` and :class:`~tumble.Torque` with constant vectors.
+    events : sequence
+        Not supported (must be empty): use :func:`~tumble.rigid.simulate`.
+    record_every : int
+        Keep every k-th step (and the last), to bound memory.
+
+    Returns
+    -------
+    BatchTrajectory
+        Arrays with a leading body axis; ``batch[k]`` is body ``k``'s
+        :class:`~tumble.rigid.trajectory.Trajectory`.
+
+    Raises
+    ------
+    ValueError
+        For an adaptive method, impulses, callable loads or events, and for per-body arrays
+        whose shape is not ``(N, …)`` (the message names the argument and both shapes).
+
+    Examples
+    --------
+    Three spins of one body about x, at 1, 2 and 3 rad/s, turn by exactly ω t with
+    ``lie-euler``:
+
+    >>> import numpy as np
+    >>> from tumble import RigidBody, simulate_batch
+    >>> omega0 = [[1.0, 0, 0], [2.0, 0, 0], [3.0, 0, 0]]
+    >>> batch = simulate_batch(RigidBody(1.0, np.eye(3)), 1.0, method="lie-euler", h=0.1,
+    ...                        omega0=omega0)
+    >>> len(batch), batch.R.shape
+    (3, (3, 11, 3, 3))
+    >>> np.allclose(batch.R[:, -1, 1, 1], np.cos([1.0, 2.0, 3.0]))
+    True
+    """
+    spec = get_method(method)
+    if spec.adaptive:
+        raise ValueError(
+            f"method={method!r} is adaptive; simulate_batch runs the fixed-step methods "
+            f"{FIXED_METHODS} (use simulate for {method!r})"
+        )
+    t0, t_end = initial.check_times(t0, t_end)
+    h, _, _ = initial.check_steps(spec, h, None, None)
+    every = _check_record_every(record_every)
+    if list(events):
+        raise ValueError("simulate_batch does not locate events; use tumble.simulate for events")
+    bodies, one_body = _bodies(body_or_bodies)
+    arrays = {"omega0": omega0, "L0": L0, "R0": R0, "q0": q0, "x0": x0, "v0": v0}
+    n_bodies, source = _batch_size(bodies, one_body, arrays)
+    rows = {name: _rows(value, name, n_bodies, source) for name, value in arrays.items()}
+    bodies = bodies * n_bodies if one_body else bodies
+    R, Y = _initial_states(bodies, rows["R0"], rows["q0"], rows["omega0"], rows["L0"],
+                           rows["x0"], rows["v0"], n_bodies)  # fmt: skip
+    loads = _kernel_loads(forces, bodies)
+    settings = {"h": h, "rtol": None, "atol": None, "record_every": every, "compiled": True}
+    return _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings)
+
+
+def _pack(family: str, R: np.ndarray, Y: np.ndarray):
+    """The kernel's ``(Z, RN)`` for every body, and the attitudes of the first sample."""
+    n = len(R)
+    if family == "lie":
+        return np.concatenate([np.zeros((n, 3)), Y], axis=1), R.copy(), R
+    RN = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+    if family == "quat":
+        q = so3.quat_from_matrix(R)
+        return np.concatenate([q, Y], axis=1), RN, so3.matrix_from_quat(q)
+    return np.concatenate([R.reshape(n, 9), Y], axis=1), RN, R
+
+
+def _unpack(family: str, Z: np.ndarray, RN: np.ndarray):
+    """Final ``(R, q or None, Y)`` of every body."""
+    if family == "lie":
+        return RN, None, Z[:, 3:]
+    if family == "quat":
+        return so3.matrix_from_quat(Z[:, :4]), Z[:, :4], Z[:, 4:]
+    return Z[:, :9].reshape(-1, 3, 3), None, Z[:, 9:]
+
+
+def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTrajectory:
+    """Run the kernel for every body; lay the samples out as (body, time, …) arrays."""
+    F, tau, points, point_forces = loads
+    family, n_bodies = spec.family, len(bodies)
+    n = fixed_step_count(t0, t_end, h)
+    size = n // every  # samples the kernel takes: steps every, 2 every, …
+    Z, RN, R_first = _pack(family, R, Y)
+    first = {"R": R_first, "Y": Y, "q": Z[:, :4].copy() if family == "quat" else None}
+    shapes = {"t": (), "R": (3, 3), "q": (4,), "Y": (9,)}
+    recorded = {name: np.empty((n_bodies, size, *shape)) for name, shape in shapes.items()}
+    counts, failed = np.zeros(n_bodies, dtype=np.int64), np.zeros(n_bodies, dtype=np.int64)
+    mass = _per_body(bodies, lambda body: body.mass)
+    run_batch(FAMILY_CODES[family], spec.dexpinv, spec.tableau.A, spec.tableau.b, Z, RN, t0, h,
+              n, t_end, _per_body(bodies, lambda body: body.inertia_inverse), mass, F, tau,
+              points, point_forces, every, recorded["t"], recorded["R"], recorded["q"],
+              recorded["Y"], counts, failed)  # fmt: skip
+    times = np.concatenate([[t0], _record_times(t0, t_end, h, n, every)])
+    final = times[-1] != t_end  # as simulate: add the end state unless the last sample is it
+    last = dict(zip(("R", "q", "Y"), _unpack(family, Z, RN), strict=True))
+    samples = {
+        name: np.concatenate([first[name][:, None], recorded[name]]
+                             + ([last[name][:, None]] if final else []), axis=1)
+        for name in ("R", "Y", "q") if first[name] is not None
+    }  # fmt: skip
+    times = np.append(times, t_end) if final else times
+    n_recorded = np.where(failed < 0, len(times), 1 + counts)
+    for k in np.flatnonzero(failed >= 0):
+        for array in samples.values():
+            array[k, n_recorded[k] :] = np.nan
+    Ys = samples["Y"]
+    return BatchTrajectory(
+        t=times,
+        x=Ys[..., :3],
+        v=Ys[..., 3:6] / mass[:, None, None],
+        R=samples["R"],
+        L_world=Ys[..., 6:],
+        bodies=bodies,
+        method=spec.name,
+        settings=settings,
+        status=np.where(failed < 0, 0, -1),
+        messages=_messages(failed, t0, t_end, h, n),
+        n_steps=np.where(failed < 0, n, failed - 1),
+        n_recorded=n_recorded,
+        q_raw=samples.get("q"),
+    )
+
+
+def _messages(failed: np.ndarray, t0: float, t_end: float, h: float, n: int) -> list[str]:
+    """Per body, ``simulate``'s message: the end reached, or the step that was not finite."""
+    messages = ["The simulation reached t_end."] * len(failed)
+    for k in np.flatnonzero(failed >= 0):
+        step = int(failed[k])
+        t_old = t0 + (step - 1) * h
+        t_new = t_end if step == n else t0 + step * h
+        messages[k] = (
+            f"the state became non-finite (nan or inf) in the step from t={t_old!r} to "
+            f"t={t_new!r}; the samples after the last finite one are NaN"
+        )
+    return messages

@@ -1,0 +1,171 @@
+"""simulate_batch: the numbers of N single simulate runs, a body axis, and clear refusals."""
+
+import numpy as np
+import pytest
+
+from tumble import so3
+from tumble.rigid import (
+    METHODS,
+    Force,
+    Gravity,
+    Impulse,
+    RigidBody,
+    Torque,
+    simulate,
+    simulate_batch,
+)
+
+FIXED = [name for name, method in METHODS.items() if not method.adaptive]
+LOADS = [
+    Gravity(),
+    Force((0.1, 0.2, 0.3), point=(0.1, 0.0, 0.05)),
+    Force((0.0, -0.5, 0.0)),
+    Torque((0.01, 0.0, -0.02)),
+]
+FIELDS = ["t", "x", "v", "R", "L_world", "q", "omega_body", "energy"]
+RNG = np.random.default_rng(7)
+N = 3
+OMEGA0, X0, V0 = RNG.normal(size=(N, 3)), RNG.normal(size=(N, 3)), RNG.normal(size=(N, 3))
+R0 = so3.exp(RNG.normal(size=(N, 3)))
+
+
+@pytest.fixture(scope="module")
+def body():
+    return RigidBody(2.0, [[2.0, 0.1, 0.0], [0.1, 1.5, 0.05], [0.0, 0.05, 1.0]])
+
+
+@pytest.fixture(scope="module")
+def bodies():
+    return [
+        RigidBody(1.0, [1.0, 2.0, 2.5]),
+        RigidBody(3.0, [[2.0, 0.1, 0.0], [0.1, 1.5, 0.05], [0.0, 0.05, 1.0]]),
+        RigidBody(0.5, [2.0, 1.0, 2.0 / 3.0], allow_unphysical=True),
+    ]
+
+
+def assert_same_as_single_runs(batch, single_runs):
+    """Bit for bit: the batch runs the same compiled loop as simulate, on the same numbers."""
+    assert len(batch) == len(single_runs)
+    for k, single in enumerate(single_runs):
+        for name in FIELDS:
+            np.testing.assert_array_equal(getattr(batch[k], name), getattr(single, name), name)
+        assert batch[k].settings == single.settings
+        assert (batch[k].n_steps, batch[k].status) == (single.n_steps, single.status)
+
+
+@pytest.mark.parametrize("method", FIXED)
+def test_one_body_from_n_states_matches_n_single_runs_under_all_loads(body, method):
+    options = dict(method=method, h=0.03, forces=LOADS, record_every=4)  # 34 steps: end added
+    batch = simulate_batch(body, 1.0, omega0=OMEGA0, x0=X0, v0=V0, R0=R0, **options)
+    singles = [
+        simulate(body, 1.0, omega0=OMEGA0[k], x0=X0[k], v0=V0[k], R0=R0[k], **options)
+        for k in range(N)
+    ]
+    assert_same_as_single_runs(batch, singles)
+
+
+@pytest.mark.parametrize("method", ["rkmk4", "rk4-quat"])
+def test_different_bodies_match_single_runs_with_q0_and_l0(bodies, method):
+    q0 = so3.quat_from_matrix(R0) * [[1.0], [2.0], [0.5]]  # not unit: normalised as simulate
+    options = dict(method=method, h=0.05, forces=[Gravity(), Torque((0.0, 0.1, 0.0))])
+    batch = simulate_batch(bodies, 2.0, q0=q0, L0=OMEGA0, t0=0.5, **options)
+    singles = [
+        simulate(bodies[k], 2.0, q0=q0[k], L0=OMEGA0[k], t0=0.5, **options) for k in range(N)
+    ]
+    assert_same_as_single_runs(batch, singles)
+
+
+def test_arrays_have_a_leading_body_axis(body):
+    batch = simulate_batch(body, 1.0, h=0.1, omega0=OMEGA0, record_every=5)
+    assert len(batch) == N and batch.t.shape == (3,)  # t0, step 5, step 10
+    assert batch.x.shape == batch.v.shape == batch.L_world.shape == (N, 3, 3)
+    assert batch.R.shape == (N, 3, 3, 3) and batch.q.shape == (N, 3, 4)
+    assert batch.energy.shape == batch.orthogonality_error.shape == (N, 3)
+    assert np.all(batch.success) and list(batch.n_steps) == [10] * N
+
+
+@pytest.mark.parametrize("name", ["q", "omega_body", "energy", "orthogonality_error"])
+def test_derived_quantities_are_those_of_each_bodys_trajectory(bodies, name):
+    batch = simulate_batch(bodies, 1.0, method="rk4-matrix", h=0.1, omega0=OMEGA0)
+    expected = np.array([getattr(batch[k], name) for k in range(N)])
+    np.testing.assert_allclose(getattr(batch, name), expected, rtol=1e-14, atol=1e-15)
+
+
+def test_to_xarray_has_a_body_dimension_and_round_trips(bodies):
+    batch = simulate_batch(bodies, 1.0, h=0.1, omega0=OMEGA0, x0=X0)
+    ds = batch.to_xarray()
+    assert ds["R"].dims == ("body", "time", "row", "col")
+    assert ds["x"].dims == ("body", "time", "axis") and ds["energy"].dims == ("body", "time")
+    np.testing.assert_array_equal(ds["body"].values, np.arange(N))
+    np.testing.assert_array_equal(ds["time"].values, batch.t)
+    for name in ["x", "v", "R", "q", "omega_body", "L_world", "energy"]:
+        np.testing.assert_array_equal(ds[name].values, getattr(batch, name))
+    np.testing.assert_array_equal(ds["mass"].values, [1.0, 3.0, 0.5])
+    one = batch[1].to_xarray()
+    assert ds["L_world"].attrs == one["L_world"].attrs
+    np.testing.assert_array_equal(ds.sel(body=1)["energy"].values, one["energy"].values)
+    assert ds.attrs["method"] == "rkmk4"
+
+
+def test_a_body_that_blows_up_stops_alone(body):
+    x0 = [[0.0, 0.0, 0.0], [1.79e308, 0.0, 0.0]]
+    v0 = [[1.0, 0.0, 0.0], [8e307, 0.0, 0.0]]  # x + h v overflows in the first step
+    batch = simulate_batch(body, 1.0, h=0.1, x0=x0, v0=v0)
+    assert list(batch.status) == [0, -1] and list(batch.n_steps) == [10, 0]
+    assert "non-finite" in batch.messages[1] and "t=0.0" in batch.messages[1]
+    assert len(batch[1].t) == 1 and np.all(np.isnan(batch.x[1, 1:]))
+    single = simulate(body, 1.0, h=0.1, x0=x0[0], v0=v0[0])
+    np.testing.assert_array_equal(batch[0].R, single.R)
+
+
+def test_adaptive_method_is_refused_with_the_fixed_ones_listed(body):
+    with pytest.raises(ValueError, match="rkmk45.*adaptive.*'rkmk4'"):
+        simulate_batch(body, 1.0, method="rkmk45", h=0.1, omega0=OMEGA0)
+
+
+@pytest.mark.parametrize(
+    "forces",
+    [[Impulse((0, 0, 0), (1, 0, 0), time=0.5)], [Torque(lambda t, state: (0.0, 0.0, t))]],
+    ids=["impulse", "callable"],
+)
+def test_impulses_and_callable_loads_are_refused_naming_what_is_supported(body, forces):
+    with pytest.raises(ValueError, match="constant loads only.*Gravity"):
+        simulate_batch(body, 1.0, h=0.1, omega0=OMEGA0, forces=forces)
+
+
+def test_events_are_refused(body):
+    with pytest.raises(ValueError, match="events"):
+        simulate_batch(body, 1.0, h=0.1, omega0=OMEGA0, events=[lambda t, s: s.x[2]])
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (
+            dict(omega0=(1.0, 0.0, 0.0)),
+            r"omega0 has shape \(3,\); simulate_batch expects \(N, 3\)",
+        ),
+        (dict(omega0=OMEGA0, R0=R0[:2]), r"R0 has shape \(2, 3, 3\); expected \(3, 3, 3\)"),
+        (dict(omega0=OMEGA0, x0=np.zeros((3, 2))), r"x0 has shape \(3, 2\); expected \(3, 3\)"),
+        (dict(q0=np.zeros((3, 4))), r"q0\[0\] has zero norm"),
+        (dict(R0=2 * R0), "R0 must be a rotation matrix"),
+        (dict(omega0=OMEGA0, L0=OMEGA0), "at most one of omega0"),
+        (dict(v0=[[0, 0, 0], [np.nan, 0, 0], [0, 0, 0]]), r"v0\[1\] is not finite"),
+        (dict(omega0=OMEGA0, h=-0.1), "h=-0.1"),
+        (dict(omega0=OMEGA0, record_every=0), "record_every=0"),
+    ],
+    ids=lambda value: None if isinstance(value, dict) else value[:24],
+)
+def test_bad_per_body_input_names_the_argument_and_shapes(body, arguments, message):
+    arguments = {"h": 0.1, **arguments}
+    with pytest.raises(ValueError, match=message):
+        simulate_batch(body, 1.0, **arguments)
+
+
+def test_bodies_are_counted_and_checked(bodies):
+    with pytest.raises(
+        ValueError, match=r"omega0 has shape \(2, 3\); expected \(3, 3\).*3 bodies"
+    ):
+        simulate_batch(bodies, 1.0, h=0.1, omega0=OMEGA0[:2])
+    with pytest.raises(ValueError, match=r"body_or_bodies\[1\]"):
+        simulate_batch([bodies[0], "body"], 1.0, h=0.1)
