@@ -2,6 +2,7 @@
 
 import json
 
+import pytest
 from typer.testing import CliRunner
 
 from tumble.cli import app
@@ -170,3 +171,31 @@ def test_every_command_has_help():
     for command in ("list", "run", "compare", "stability", "view", "mass"):
         result = runner.invoke(app, [command, "--help"])
         assert result.exit_code == 0 and "Usage" in result.output
+
+
+BAD_FILES = {
+    "syntax": ('scenario = "t-handle"\n[options\n', "line 2"),
+    "scenario": ('scenario = "t-handel"\n', "t-handel"),
+    "top-level key": ('scenario = "t-handle"\nsteps = 3\n', "steps"),
+    "type": ('scenario = "t-handle"\n[options]\nh = "fast"\n', "options.h"),
+    "value": ('scenario = "beam"\n[options]\nn_elements = 0\n', "options.n_elements"),
+    "shape": (
+        'scenario = "rigid-body"\n[options.body]\nshape = "cone"\nmass = 1.0\n',
+        "options.body",
+    ),
+    "dimension": (
+        'scenario = "rigid-body"\n[options.body]\nshape = "cylinder"\nmass = 1.0\nradius = 0.1\n',
+        "length",
+    ),
+}
+
+
+@pytest.mark.parametrize("kind", sorted(BAD_FILES))
+def test_each_kind_of_bad_file_exits_2_naming_the_key(kind, tmp_path):
+    text, named = BAD_FILES[kind]
+    path = tmp_path / f"{kind.replace(' ', '-')}.toml"
+    path.write_text(text)
+    result = runner.invoke(app, ["run", str(path), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 2, result.output
+    assert named in result.output and path.name in result.output
+    assert not (tmp_path / "out").exists()

@@ -36,7 +36,9 @@ Force = Annotated[bool, typer.Option(help="Overwrite files in an existing folder
 
 
 def _fail(message: str) -> typer.Exit:
-    errors.print(f"[bold red]error:[/] {message}", highlight=False)
+    # the message is plain text (it may hold "[options]"): no markup, no hard wrapping
+    errors.print("error:", style="bold red", end=" ")
+    errors.print(message, markup=False, highlight=False, soft_wrap=True)
     return typer.Exit(code=2)
 
 
