@@ -319,7 +319,10 @@ def animate_body(
     world = world_vertices(vertices, sampled.x, sampled.R)
     extent = float(np.max(np.ptp(vertices, axis=0)))
     arrows = load_arrows(sampled, loads, mass=trajectory.body.mass, length=ARROW_FRACTION * extent)
-    images = _render(world, faces, sampled, arrows, title, _caption(loads), (width, height))
+    caption = _caption(loads)
+    if np.ptp(sampled.x, axis=0).max() > 1e-9 * max(extent, 1e-300):
+        caption = "\n".join(filter(None, ["black: path of the centre of mass", caption]))
+    images = _render(world, faces, sampled, arrows, title, caption, (width, height))
     return write_animation(images, path, fps=fps)
 
 
