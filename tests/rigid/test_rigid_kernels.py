@@ -54,7 +54,7 @@ def test_record_every_keeps_every_kth_step_and_the_last(body):
 
 
 @pytest.mark.parametrize("h", [0.08, 0.3], ids=["series-edge", "sin-cos"])
-@pytest.mark.parametrize("method", ["lie-euler", "seed-rk4", "rkmk4"])
+@pytest.mark.parametrize("method", ["lie-euler", "seed-rk4", "rkmk4", "rkmk8"])
 def test_kernel_matches_reference_for_large_rotations_per_step(body, method, h):
     # |ω| ≈ 2.7 rad/s: h = 0.08 turns ≈ 0.22 rad per step, near the end of the kernels'
     # Taylor series for exp and dexp⁻¹ (kernels.SERIES_ANGLE = 0.25), where their truncation

@@ -135,7 +135,7 @@ BAD_FILES = {
     "unknown method": (
         T_HANDLE + '[options]\nmethod = "rk5"\n',
         "options.method = 'rk5': must be one of euler, rk4-matrix, rk4-quat, lie-euler, "
-        "seed-rk4, rkmk4, rkmk45",
+        "seed-rk4, rkmk4, rkmk8, rkmk45",
     ),
     "unknown method in a list": (
         'scenario = "torus-spin"\n[options]\nmethods = ["rkmk4", "rk9"]\n',
@@ -143,7 +143,7 @@ BAD_FILES = {
     ),
     "unknown ODE method": (
         'scenario = "projectile"\n[options]\nmethod = "rkmk4"\n',
-        "options.method = 'rkmk4': must be one of euler, heun, midpoint, rk4, rkf45, dopri5",
+        "options.method = 'rkmk4': must be one of euler, heun, midpoint, rk4, rk8, rkf45, dopri5",
     ),
     "wrong type in a nested list": (
         T_HANDLE + '[options]\nspins = [[1.0, 0.0, "x"]]\n',

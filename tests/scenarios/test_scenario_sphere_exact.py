@@ -56,7 +56,7 @@ def test_lie_euler_is_the_exact_rotation_to_round_off(result):
     np.testing.assert_allclose(run.R, exact.sphere(run.t), rtol=0, atol=1e-14)
 
 
-@pytest.mark.parametrize("method", ["seed-rk4", "rkmk4", "rkmk45"])
+@pytest.mark.parametrize("method", ["seed-rk4", "rkmk4", "rkmk8", "rkmk45"])
 def test_lie_algebra_methods_are_exact_because_commutators_vanish(result, method):
     assert result.summary["results"][method]["max_error"] < 1e-14
 

@@ -270,8 +270,9 @@ def solve(
     y0 : array_like, shape (n,)
         Initial state.
     method : str
-        ``"euler"``, ``"heun"``, ``"midpoint"``, ``"rk4"`` (fixed step; ``h`` required),
-        ``"rkf45"`` (Fehlberg 4(5)) or ``"dopri5"`` (Dormand–Prince 5(4)) (adaptive).
+        ``"euler"``, ``"heun"``, ``"midpoint"``, ``"rk4"``, ``"rk8"`` (DOP853's order-8
+        weights) (fixed step; ``h`` required), ``"rkf45"`` (Fehlberg 4(5)) or ``"dopri5"``
+        (Dormand–Prince 5(4)) (adaptive).
     h : float, optional
         The step size for fixed-step methods; the first step for adaptive ones (chosen
         automatically when omitted).

@@ -6,7 +6,7 @@
 :func:`simulate_batch`     many bodies in one compiled, parallel call; a :class:`BatchTrajectory`
 :class:`Gravity` …         loads: :class:`Force`, :class:`Torque`, :class:`Impulse`
 :data:`METHODS`            ``euler``, ``lie-euler``, ``rk4-matrix``, ``rk4-quat``,
-                           ``seed-rk4``, ``rkmk4``, ``rkmk45``
+                           ``seed-rk4``, ``rkmk4``, ``rkmk8``, ``rkmk45``
 =========================  ===================================================================
 """
 

@@ -339,7 +339,7 @@ def simulate_batch(
         End time (s), > ``t0``; the last step lands on it.
     method : str
         A fixed-step method: ``"euler"``, ``"lie-euler"``, ``"rk4-matrix"``, ``"rk4-quat"``,
-        ``"seed-rk4"`` or ``"rkmk4"`` (default).
+        ``"seed-rk4"``, ``"rkmk4"`` (default) or ``"rkmk8"``.
     h : float
         Step (s).
     t0 : float

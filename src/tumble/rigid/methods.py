@@ -13,6 +13,8 @@ name                    family    tableau     what it is
                                               dexp⁻¹; order 2 on an asymmetric body
 ``rkmk4``               lie       RK4         Runge–Kutta–Munthe-Kaas, stages corrected by
                                               dexp⁻¹: order 4, stays on SO(3)
+``rkmk8``               lie       DOP853      RKMK with the 12 stages and order-8 weights of
+                                              Dormand–Prince's DOP853: order 8
 ``rkmk45``              lie       Fehlberg    adaptive RKMK with Fehlberg's 4(5) pair
 ======================  ========  ==========  =================================================
 """
@@ -21,7 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from tumble.ode.tableaux import EULER, FEHLBERG45, RK4, ButcherTableau
+from tumble.ode.tableaux import DORMAND_PRINCE8, EULER, FEHLBERG45, RK4, ButcherTableau
 
 
 @dataclass(frozen=True)
@@ -62,6 +64,7 @@ METHODS: dict[str, Method] = {
         Method("lie-euler", "lie", EULER),
         Method("seed-rk4", "lie", RK4, dexpinv=False),
         Method("rkmk4", "lie", RK4),
+        Method("rkmk8", "lie", DORMAND_PRINCE8),
         Method("rkmk45", "lie", FEHLBERG45),
     )
 }

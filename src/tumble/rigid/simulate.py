@@ -266,7 +266,8 @@ def simulate(
         End time (s), > ``t0``. The last step lands on it exactly.
     method : str
         ``"euler"``, ``"lie-euler"``, ``"rk4-matrix"``, ``"rk4-quat"``, ``"seed-rk4"``,
-        ``"rkmk4"`` (default) or ``"rkmk45"`` (adaptive); see :mod:`tumble.rigid.methods`.
+        ``"rkmk4"`` (default), ``"rkmk8"`` (order 8) or ``"rkmk45"`` (adaptive); see
+        :mod:`tumble.rigid.methods`.
     h : float
         Step (s): required for the fixed-step methods; the first step for ``rkmk45``.
     rtol, atol : float, optional

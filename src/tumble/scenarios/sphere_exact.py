@@ -33,7 +33,7 @@ from tumble.viz import rigid
 NAME = "sphere-exact"
 SUMMARY = "Seed 002 tasks 2–4: the unit sphere spun about x; every method against exp(t x̃)."
 
-METHODS = ("euler", "lie-euler", "rk4-matrix", "rk4-quat", "seed-rk4", "rkmk4", "rkmk45")
+METHODS = ("euler", "lie-euler", "rk4-matrix", "rk4-quat", "seed-rk4", "rkmk4", "rkmk8", "rkmk45")
 """The methods compared by default (all of :data:`tumble.rigid.METHODS`)."""
 OMEGA0 = (1.0, 0.0, 0.0)
 """Seed 002's initial angular velocity (rad/s); with I = Id also L (kg m²/s)."""
