@@ -1,6 +1,7 @@
 """The command line through typer's test runner: exit codes and messages."""
 
 import json
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -81,9 +82,8 @@ def test_a_bad_toml_file_exits_2_naming_the_key(tmp_path):
 def test_the_example_file_gives_the_same_numbers_as_the_built_in(tmp_path):
     short = ["--t-end", "3", "--no-animation"]
     by_name = runner.invoke(app, ["run", "t-handle", "--out", str(tmp_path / "a"), *short])
-    by_file = runner.invoke(
-        app, ["run", "examples/t-handle.toml", "--out", str(tmp_path / "b"), *short]
-    )
+    example = Path(__file__).parent.parent / "examples" / "t-handle.toml"
+    by_file = runner.invoke(app, ["run", str(example), "--out", str(tmp_path / "b"), *short])
     assert by_name.exit_code == 0 and by_file.exit_code == 0, by_file.output
     assert _summary(tmp_path / "a") == _summary(tmp_path / "b")
 
@@ -199,3 +199,42 @@ def test_each_kind_of_bad_file_exits_2_naming_the_key(kind, tmp_path):
     assert result.exit_code == 2, result.output
     assert named in result.output and path.name in result.output
     assert not (tmp_path / "out").exists()
+
+
+def test_force_replaces_the_previous_run_and_view_draws_the_new_one(tmp_path):
+    out = tmp_path / "run"
+    first = ["run", "t-handle", "--t-end", "1", "--out", str(out)]
+    assert runner.invoke(app, first).exit_code == 0
+    old_page = (out / "view.html").read_text()
+    again = ["run", "t-handle", "--t-end", "2", "--no-animation", "--force", "--out", str(out)]
+    assert runner.invoke(app, again).exit_code == 0
+    assert not (out / "animation.gif").exists() and not (out / "view.html").exists()
+    assert {p.name for p in out.iterdir()} == set(_summary(out)["files"]) | {"summary.json"}
+    assert runner.invoke(app, ["view", str(out), "--no-open"]).exit_code == 0
+    assert (out / "view.html").read_text() != old_page
+
+
+def test_mass_names_the_command_line_option_for_an_inside_out_mesh(tmp_path):
+    from tumble import meshes
+
+    mesh = meshes.box((1.0, 2.0, 3.0))
+    mesh.invert()
+    path = meshes.save(mesh, tmp_path / "inside.stl")
+    result = runner.invoke(app, ["mass", str(path), "--density", "1"])
+    assert result.exit_code == 2 and "--fix-inside-out" in result.output
+    fixed = runner.invoke(app, ["mass", str(path), "--density", "1", "--fix-inside-out"])
+    assert fixed.exit_code == 0 and "note:" in fixed.output
+    assert float(fixed.output.split(" kg ")[1].split()[0]) == pytest.approx(6.0)
+
+
+def test_rigid_body_without_a_file_says_to_use_one():
+    result = runner.invoke(app, ["run", "rigid-body"])
+    assert result.exit_code == 2 and "TOML" in result.output
+
+
+def test_a_value_refused_by_the_scenario_names_the_file(tmp_path):
+    path = tmp_path / "fat.toml"
+    path.write_text('scenario = "torus-spin"\n[options]\nminor_radius = 2.0\n')
+    result = runner.invoke(app, ["run", str(path), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert "fat.toml" in result.output and "minor_radius" in result.output

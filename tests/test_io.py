@@ -123,3 +123,30 @@ def test_netcdf_attrs_keep_numbers_and_encode_the_rest():
     assert attrs["h"] == 0.1 and attrs["ok"] == 1 and "skip" not in attrs
     np.testing.assert_array_equal(attrs["v"], [1, 2])
     assert json.loads(attrs["m"]) == ["a", "b"]
+
+
+def test_summary_json_is_strict_json_with_null_for_non_finite_numbers(tmp_path):
+    path = write_json(tmp_path / "s.json", {"a": float("nan"), "b": [1.0, float("inf")], "c": 2})
+    assert json.loads(path.read_text(), parse_constant=pytest.fail) == {
+        "a": None,
+        "b": [1.0, None],
+        "c": 2,
+    }
+
+
+def test_atomic_writes_of_one_target_use_distinct_temporary_names(tmp_path):
+    seen = []
+    atomic_write(tmp_path / "x.png", lambda tmp: (seen.append(tmp), tmp.write_text("1")))
+    atomic_write(tmp_path / "x.png", lambda tmp: (seen.append(tmp), tmp.write_text("2")))
+    assert seen[0] != seen[1] and all(p.suffix == ".png" for p in seen)
+    assert [p.name for p in tmp_path.iterdir()] == ["x.png"]
+
+
+def test_a_figure_that_fails_to_draw_leaves_no_file(tmp_path):
+    from tumble.viz._figure import new_figure, save
+
+    fig, axes = new_figure()
+    axes.plot([1, 2], [3, 4])
+    with pytest.raises(ValueError):
+        save(fig, tmp_path / "plot.nosuchformat")
+    assert list(tmp_path.iterdir()) == []

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import inspect
 import json
+import warnings
 import webbrowser
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -165,14 +166,29 @@ def run(
 
     with _reported():
         name, options, file_animation, default = _scenario(target)
+        if name == "rigid-body" and not options:
+            raise ValueError(
+                "scenario 'rigid-body' describes your own body: run it from a TOML file "
+                "(tumble run FILE.toml; see examples/t-handle-parts.toml)"
+            )
         options = _apply(name, options, method=method, h=h, t_end=t_end)
         options = files.check_options(name, options)
         with _progress(f"running {name}") as note:
-            result = scenarios.get(name).run(**options)
+            result = _run_scenario(name, options, None if target == name else target)
             folder = _write(
                 result, out or Path("runs") / default, force, animation and file_animation, note
             )
     _show_summary(name, result.summary, folder)
+
+
+def _run_scenario(name: str, options: dict, source: str | None) -> ScenarioResult:
+    """Run ``name``; a bad value found only by the scenario names the file it came from."""
+    try:
+        return scenarios.get(name).run(**options)
+    except ValueError as error:
+        if source is None:
+            raise
+        raise ValueError(f"{source}: [options] {error}") from None
 
 
 @app.command()
@@ -257,10 +273,18 @@ def view(
         console.print("no web browser found; open the file above yourself")
 
 
+def _listed(run_dir: Path, name: str) -> bool:
+    """Whether the run's ``summary.json`` lists ``name`` (a file of this run, not a stale one)."""
+    try:
+        return name in json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))["files"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
+
+
 def _viewer(run_dir: Path) -> Path:
     """The run's ``view.html``, drawn again from ``data.nc`` when it is not there."""
     page = run_dir / "view.html"
-    if page.is_file():
+    if page.is_file() and _listed(run_dir, page.name):
         return page
     import trimesh
 
@@ -294,10 +318,17 @@ def mass_properties(
     """Mass, centre of mass, inertia and principal axes of a mesh of uniform density."""
     from tumble import mass, meshes
 
-    with _reported():
-        mesh = meshes.load(mesh_file)
-        properties = mass.from_mesh(mesh, density=density, fix_inside_out=fix_inside_out)
+    with _reported(), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            mesh = meshes.load(mesh_file)
+            properties = mass.from_mesh(mesh, density=density, fix_inside_out=fix_inside_out)
+        except ValueError as error:  # name the command-line option, not the argument
+            message = str(error).replace("fix_inside_out=True", "--fix-inside-out")
+            raise ValueError(message) from None
         moments, axes = properties.principal()
+    for warning in caught:
+        console.print(f"note: {warning.message}", highlight=False, markup=False)
     table = Table(title=f"{mesh_file} at ρ = {density:g} kg/m³", box=None)
     table.add_column("quantity")
     table.add_column("unit")

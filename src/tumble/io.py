@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import json
 import logging
-import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,30 +35,26 @@ from typing import Any
 
 import numpy as np
 
+from tumble._atomic import atomic_write
 from tumble.scenarios._base import ScenarioResult
 
 log = logging.getLogger(__name__)
 
 
-def atomic_write(path: str | Path, writer: Callable[[Path], None]) -> Path:
-    """Call ``writer(tmp)`` on a temporary sibling of ``path``, then rename it to ``path``.
-
-    The temporary file keeps the suffix (writers such as matplotlib read the format from it)
-    and is removed if ``writer`` raises.
-    """
-    path = Path(path)
-    tmp = path.with_name(f".{path.stem}.partial{path.suffix}")
-    try:
-        writer(tmp)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    return path
+def _finite(value: Any) -> Any:
+    """``value`` with every non-finite float (NaN, ±inf) replaced by None, recursively."""
+    if isinstance(value, dict):
+        return {key: _finite(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [_finite(item) for item in value]
+    if isinstance(value, float | np.floating) and not np.isfinite(value):
+        return None
+    return value
 
 
 def write_json(path: str | Path, data: dict) -> Path:
-    """Write ``data`` as indented JSON, atomically."""
-    text = json.dumps(data, indent=2, sort_keys=False) + "\n"
+    """Write ``data`` as indented, strict JSON (NaN and ±inf become ``null``), atomically."""
+    text = json.dumps(_finite(data), indent=2, sort_keys=False, allow_nan=False) + "\n"
     return atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
@@ -146,6 +141,7 @@ def write_run_folder(
         The folder.
     """
     out = prepare_folder(out, force=force)
+    _forget_previous_run(out)
     writers = list(result.figures) + (list(result.animations) if animation else [])
     files = []
     notify = on_file or (lambda name: None)
@@ -161,6 +157,24 @@ def write_run_folder(
         files.append(DATA_FILE)
     write_json(out / SUMMARY_FILE, {**result.summary, "files": files})
     return out
+
+
+def _forget_previous_run(out: Path) -> None:
+    """Remove an earlier run's ``summary.json`` and then the files it lists (``--force``).
+
+    The summary goes first, so an interruption never leaves the old summary beside new files.
+    """
+    summary = out / SUMMARY_FILE
+    if not summary.is_file():
+        return
+    try:
+        listed = json.loads(summary.read_text(encoding="utf-8")).get("files", [])
+    except (OSError, ValueError, AttributeError):
+        listed = []
+    summary.unlink()
+    for name in listed:
+        if isinstance(name, str) and Path(name).name == name:
+            (out / name).unlink(missing_ok=True)
 
 
 @dataclass(frozen=True)

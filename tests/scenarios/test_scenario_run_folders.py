@@ -62,7 +62,7 @@ def test_scenario_writes_every_promised_file(name, tmp_path):
         )
 
 
-EXAMPLES = sorted(Path("examples").glob("*.toml"))
+EXAMPLES = sorted((Path(__file__).parents[2] / "examples").glob("*.toml"))
 SHORTER = {"t_end": 0.5}
 
 

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from tumble._atomic import atomic_write
+
 DPI = 110
 
 
@@ -22,5 +24,6 @@ def new_figure(rows: int = 1, cols: int = 1, *, figsize=None, layout=None, **kwa
 
 
 def save(fig, path: str | Path, *, dpi: int = DPI, tight: bool = True) -> None:
-    """Write ``fig`` to ``path`` (format from the suffix)."""
-    fig.savefig(path, dpi=dpi, bbox_inches="tight" if tight else None)
+    """Write ``fig`` to ``path`` (format from the suffix), whole or not at all."""
+    bbox = "tight" if tight else None
+    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=dpi, bbox_inches=bbox))

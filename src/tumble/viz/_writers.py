@@ -27,6 +27,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from tumble._atomic import atomic_write
+
 FORMATS = (".gif", ".mp4")
 """Suffixes the animation writers accept."""
 GIF_COLOURS = 64
@@ -91,19 +93,25 @@ def write_animation(images: Sequence[NDArray], path: str | Path, *, fps: float =
             Image.fromarray(image).quantize(palette=palette, dither=Image.Dither.NONE)
             for image in images
         ]
-        frames[0].save(path, format="GIF", save_all=True, append_images=frames[1:],
-                       duration=round(1000 / fps), loop=0, optimize=True)  # fmt: skip
-        return path
+        return atomic_write(
+            path,
+            lambda tmp: frames[0].save(tmp, format="GIF", save_all=True,
+                                       append_images=frames[1:], duration=round(1000 / fps),
+                                       loop=0, optimize=True),
+        )  # fmt: skip
     height, width = images[0].shape[:2]
     command = ["ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
                "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
                "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
-               "-pix_fmt", "yuv420p", "-f", "mp4", str(path)]  # fmt: skip
+               "-pix_fmt", "yuv420p", "-f", "mp4"]  # fmt: skip
     data = b"".join(np.ascontiguousarray(image, dtype=np.uint8).tobytes() for image in images)
-    result = subprocess.run(command, input=data, capture_output=True, check=False)
-    if result.returncode != 0:
-        raise RuntimeError(f"ffmpeg failed writing {str(path)!r}: {result.stderr.decode()}")
-    return path
+
+    def encode(tmp: Path) -> None:
+        result = subprocess.run([*command, str(tmp)], input=data, capture_output=True, check=False)
+        if result.returncode != 0:
+            raise RuntimeError(f"ffmpeg failed writing {str(path)!r}: {result.stderr.decode()}")
+
+    return atomic_write(path, encode)
 
 
 def _gif_palette(images: Sequence[NDArray]):

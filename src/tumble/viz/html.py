@@ -23,11 +23,11 @@ from __future__ import annotations
 import html
 from collections.abc import Sequence
 from os import PathLike
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from tumble._atomic import atomic_write
 from tumble.rigid.forces import Force, Gravity, Impulse, Torque
 from tumble.viz._viewer_layout import (
     ARROW_COLOR,
@@ -129,7 +129,7 @@ def html_viewer(
     )
     page = page.replace("</head>", f"    <title>{html.escape(title)}</title>\n</head>", 1)
     if path is not None:
-        Path(path).write_text(page, encoding="utf-8")
+        atomic_write(path, lambda tmp: tmp.write_text(page, encoding="utf-8"))
     return page
 
 
