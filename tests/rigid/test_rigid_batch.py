@@ -22,7 +22,7 @@ LOADS = [
     Force((0.0, -0.5, 0.0)),
     Torque((0.01, 0.0, -0.02)),
 ]
-FIELDS = ["t", "x", "v", "R", "L_world", "q", "omega_body", "energy"]
+FIELDS = ["t", "x", "v", "R", "L_world", "q", "omega_body", "energy", "orthogonality_error"]
 RNG = np.random.default_rng(7)
 N = 3
 OMEGA0, X0, V0 = RNG.normal(size=(N, 3)), RNG.normal(size=(N, 3)), RNG.normal(size=(N, 3))
@@ -51,6 +51,7 @@ def assert_same_as_single_runs(batch, single_runs):
             np.testing.assert_array_equal(getattr(batch[k], name), getattr(single, name), name)
         assert batch[k].settings == single.settings
         assert (batch[k].n_steps, batch[k].status) == (single.n_steps, single.status)
+        assert batch[k].message == single.message
 
 
 @pytest.mark.parametrize("method", FIXED)
@@ -116,6 +117,37 @@ def test_a_body_that_blows_up_stops_alone(body):
     assert len(batch[1].t) == 1 and np.all(np.isnan(batch.x[1, 1:]))
     single = simulate(body, 1.0, h=0.1, x0=x0[0], v0=v0[0])
     np.testing.assert_array_equal(batch[0].R, single.R)
+
+
+@pytest.mark.parametrize("record_every", [1, 3])
+@pytest.mark.parametrize("method", FIXED)
+def test_a_body_stopped_after_many_steps_ends_with_its_single_runs_last_finite_state(
+    body, method, record_every
+):
+    # x grows by h v = 1e306 per step from 1e308: step 80 overflows (max 1.8e308), so the
+    # last finite state is step 79, not a recorded one when record_every = 3.
+    x0, v0 = [[0.0, 0.0, 0.0], [1e308, 0.0, 0.0]], [[1.0, 0.0, 0.0], [1e307, 0.0, 0.0]]
+    options = dict(method=method, h=0.1, record_every=record_every)
+    batch = simulate_batch(body, 10.0, x0=x0, v0=v0, omega0=OMEGA0[:2], **options)
+    singles = [
+        simulate(body, 10.0, x0=x0[k], v0=v0[k], omega0=OMEGA0[k], **options) for k in range(2)
+    ]
+    assert_same_as_single_runs(batch, singles)
+    assert list(batch.status) == [0, -1] and list(batch.n_steps) == [100, 79]
+    assert batch[1].t[-1] == batch.t_last[1] == pytest.approx(7.9, abs=1e-12)
+    assert len(batch[1].t) == {1: 80, 3: 28}[record_every]  # t0, 26 or 79 samples, step 79
+    assert np.all(np.isnan(batch.x[1, len(batch[1].t) :]))
+
+
+def test_a_spin_that_overflows_between_recorded_samples_keeps_its_last_finite_state(body):
+    omega0 = [[0.1, 0.2, 0.3], [1e154, 1e154, 1e154]]  # euler: R overflows in step 2
+    options = dict(method="euler", h=0.1, record_every=3)
+    batch = simulate_batch(body, 1.0, omega0=omega0, **options)
+    singles = [simulate(body, 1.0, omega0=omega0[k], **options) for k in range(2)]
+    assert_same_as_single_runs(batch, singles)
+    np.testing.assert_array_equal(batch[1].t, [0.0, 0.1])
+    np.testing.assert_array_equal(batch.t_last, [1.0, 0.1])
+    np.testing.assert_array_equal(batch.to_xarray()["t_last"].values, [1.0, 0.1])
 
 
 def test_adaptive_method_is_refused_with_the_fixed_ones_listed(body):

@@ -11,6 +11,7 @@ import trimesh
 
 from tumble import meshes, scenarios
 from tumble.scenarios.files import check_options, options_model, read
+from tumble.scenarios.option_models import THREE_VECTORS
 
 EXAMPLES = Path(__file__).parents[2] / "examples"
 TOML_FILES = sorted(EXAMPLES.glob("*.toml"))
@@ -148,6 +149,36 @@ BAD_FILES = {
     "wrong type in a nested list": (
         T_HANDLE + '[options]\nspins = [[1.0, 0.0, "x"]]\n',
         "options.spins[0][2] = 'x': must be a number",
+    ),
+    "short spin": (
+        T_HANDLE + "[options]\nspins = [[1.0, 0.0]]\n",
+        "options.spins[0] = [1.0, 0.0]: must be a list of 3 numbers (got 2)",
+    ),
+    "long second spin": (
+        T_HANDLE + "[options]\nspins = [[1.0, 0.0, 0.0], [1.0, 2.0, 3.0, 4.0]]\n",
+        "options.spins[1] = [1.0, 2.0, 3.0, 4.0]: must be a list of 3 numbers (got 4)",
+    ),
+    "no spins": (T_HANDLE + "[options]\nspins = []\n", "options.spins = []: must have at least"),
+    "short omega0": (
+        'scenario = "torus-spin"\n[options]\nomega0 = [1.0, 1.0]\n',
+        "options.omega0 = [1.0, 1.0]: must be a list of 3 numbers (got 2)",
+    ),
+    "short vertex": (
+        'scenario = "prism-impulse"\n[options]\nvertex = [45.0, 18.7]\n',
+        "options.vertex = [45.0, 18.7]: must be a list of 3 numbers (got 2)",
+    ),
+    "no methods": (
+        'scenario = "convergence"\n[options]\nmethods = []\n',
+        "options.methods = []: must have at least one item",
+    ),
+    "one distinct step count": (
+        'scenario = "convergence"\n[options]\nstep_counts = [100, 100]\n',
+        "options.step_counts = [100, 100]: must hold at least 2 distinct values",
+    ),
+    "adaptive method for an order": (
+        'scenario = "convergence"\n[options]\nmethods = ["rkmk4", "rkmk45"]\n',
+        "options.methods = ['rkmk4', 'rkmk45']: must be one of euler, rk4-matrix, rk4-quat, "
+        "lie-euler, seed-rk4, rkmk4, rkmk8",
     ),
     "float for an integer": (
         'scenario = "beam"\n[options]\nn_elements = 20.5\n',
@@ -342,3 +373,59 @@ def test_trimesh_writes_the_open_mesh_that_the_test_above_uses(tmp_path):
     open_box.update_faces(np.arange(len(open_box.faces)) != 0)
     open_box.export(tmp_path / "open.stl")
     assert not trimesh.load_mesh(tmp_path / "open.stl").is_watertight
+
+
+DERIVED = sorted(set(scenarios.names()) - {"rigid-body"})
+
+
+def three_vector_options() -> list[tuple[str, str]]:
+    """``(scenario, option)`` for every derived option in THREE_VECTORS."""
+    return [
+        (name, option)
+        for name in DERIVED
+        for option in options_model(name).model_fields
+        if option in THREE_VECTORS
+    ]
+
+
+def test_every_three_vector_name_is_an_option_of_a_built_in_scenario():
+    assert {option for _, option in three_vector_options()} == THREE_VECTORS
+
+
+@pytest.mark.parametrize("name", DERIVED)
+def test_every_option_whose_default_is_made_of_3_vectors_is_listed(name):
+    for parameter in inspect.signature(scenarios.get(name).run).parameters.values():
+        default = np.asarray(parameter.default if parameter.default is not None else [])
+        if default.dtype.kind == "f" and default.shape[-1:] == (3,):
+            assert parameter.name in THREE_VECTORS, f"{name}: {parameter.name}"
+
+
+@pytest.mark.parametrize(("name", "option"), three_vector_options())
+def test_a_three_vector_option_of_two_numbers_is_refused_by_its_key_path(name, option):
+    nested = option == "spins"  # a list of vectors
+    value = [[1.0, 2.0]] if nested else [1.0, 2.0]
+    path = f"options.{option}[0]" if nested else f"options.{option}"
+    with pytest.raises(ValueError, match=re.escape(f"{path} = [1.0, 2.0]: must be a list of 3")):
+        check_options(name, {option: value})
+
+
+@pytest.mark.parametrize(("name", "option"), three_vector_options())
+def test_a_three_vector_option_of_three_numbers_is_accepted(name, option):
+    value = [[1, 2, 3]] if option == "spins" else [1, 2, 3]
+    expected = [[1.0, 2.0, 3.0]] if option == "spins" else [1.0, 2.0, 3.0]
+    assert check_options(name, {option: value}) == {option: expected}
+
+
+@pytest.mark.parametrize(
+    ("name", "option"),
+    [("t-handle", "spins"), ("convergence", "methods"), ("convergence", "step_counts")]
+    + [(name, "methods") for name in ("prism-impulse", "sphere-exact", "torus-spin")],
+)
+def test_an_empty_list_is_refused_where_the_default_is_not_empty(name, option):
+    with pytest.raises(ValueError, match=re.escape(f"options.{option} = []: must have at least")):
+        check_options(name, {option: []})
+
+
+def test_convergence_lists_only_fixed_step_methods():
+    with pytest.raises(ValueError, match=r"must be one of euler, .*, rkmk8$"):
+        check_options("convergence", {"methods": "rkmk45"})

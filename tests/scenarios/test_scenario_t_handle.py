@@ -7,7 +7,7 @@ import pytest
 
 from tumble import scenarios
 from tumble.io import write_run_folder
-from tumble.scenarios.t_handle import measured_period, zero_crossings
+from tumble.scenarios.t_handle import SPINS, measured_period, zero_crossings
 
 
 @pytest.fixture(scope="module")
@@ -91,3 +91,38 @@ def test_run_folder_has_summary_and_every_figure(result, tmp_path):
 def test_no_spins_is_refused_by_name():
     with pytest.raises(ValueError, match="spins="):
         scenarios.get("t-handle").run(spins=())
+
+
+@pytest.fixture(scope="module")
+def diverged():
+    # euler at h = 5 s multiplies |R| by about √(1 + (h ω)²) per step: the state overflows
+    # between t = 65 and 70 s, long before t_end.
+    return scenarios.get("t-handle").run(method="euler", h=5.0, t_end=200.0, spins=[SPINS[0]])
+
+
+def test_a_diverged_spin_reports_its_status_and_no_measured_numbers(diverged):
+    spin = diverged.summary["spins"][0]
+    assert spin["status"] == -1
+    assert "non-finite" in spin["message"] and "t=65.0 to t=70.0" in spin["message"]
+    measured = [
+        "period_measured",
+        "period_relative_difference",
+        "energy_drift",
+        "momentum_drift",
+        "error_vs_exact",
+        "max_orthogonality_error",
+    ]
+    assert {name: spin[name] for name in measured} == dict.fromkeys(measured)
+    assert spin["period_closed_form"] == pytest.approx(47.2614505, rel=1e-7)
+    assert json.loads(json.dumps(spin, allow_nan=False)) == spin  # no Infinity or NaN
+
+
+def test_spins_that_reach_t_end_report_status_zero(result):
+    for spin in result.summary["spins"]:
+        assert (spin["status"], spin["message"]) == (0, "The simulation reached t_end.")
+
+
+def test_a_diverged_spin_still_writes_its_run_folder_without_warnings(diverged, tmp_path):
+    folder = write_run_folder(diverged, tmp_path / "run")  # filterwarnings = error
+    assert json.loads((folder / "summary.json").read_text())["spins"][0]["status"] == -1
+    assert (folder / "drift.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

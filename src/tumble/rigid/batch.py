@@ -50,7 +50,9 @@ class BatchTrajectory:
     settings : dict
         ``h``, ``record_every``, as :class:`~tumble.rigid.trajectory.Trajectory`'s.
     status : ndarray of int, shape (N,)
-        0: reached ``t_end``; -1: stopped by a non-finite state (its later samples are NaN).
+        0: reached ``t_end``; -1: stopped by a non-finite state. A stopped body ends, as in
+        :func:`~tumble.rigid.simulate`, with its last finite state (at ``t_last``); its rows
+        after that one are NaN.
     messages : list of str
         What happened to each body.
     n_steps : ndarray of int, shape (N,)
@@ -59,6 +61,10 @@ class BatchTrajectory:
         How many samples of each body are valid (all ``n`` unless it stopped early).
     q_raw : ndarray, shape (N, n, 4), optional
         The quaternions the ``quat`` method carried.
+    t_last : ndarray, shape (N,), optional
+        Time (s) of each body's last valid sample, row ``n_recorded[k] - 1``: ``t_end``, or
+        for a stopped body the time of its last finite state, which lies between two times
+        of ``t`` when ``record_every > 1``. None: every sample lies on ``t``.
     """
 
     t: np.ndarray
@@ -74,6 +80,7 @@ class BatchTrajectory:
     n_steps: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     n_recorded: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     q_raw: np.ndarray | None = None
+    t_last: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.bodies)
@@ -82,8 +89,11 @@ class BatchTrajectory:
         """Body ``k``'s :class:`~tumble.rigid.trajectory.Trajectory` (its valid samples)."""
         k = range(len(self))[k]  # negative indices; IndexError out of range
         n = int(self.n_recorded[k])
+        t = self.t[:n]
+        if self.t_last is not None and t[-1] != self.t_last[k]:  # stopped between samples
+            t = np.append(t[:-1], self.t_last[k])
         return Trajectory(
-            t=self.t[:n],
+            t=t,
             x=self.x[k, :n],
             v=self.v[k, :n],
             R=self.R[k, :n],
@@ -164,6 +174,11 @@ def batch_dataset(batch: BatchTrajectory):
     inertia = np.array([b.inertia for b in batch.bodies])
     data_vars["inertia"] = xr.Variable(("body", "row", "col"), inertia, {"units": "kg m2"})
     data_vars["status"] = xr.Variable("body", batch.status)
+    if batch.t_last is not None:
+        description = "time of the body's last valid sample (its last finite state if stopped)"
+        data_vars["t_last"] = xr.Variable(
+            "body", batch.t_last, {"units": "s", "description": description}
+        )
     data_vars["message"] = xr.Variable("body", np.array(batch.messages, dtype=str))
     attrs = {k: v for k, v in template.attrs.items() if k not in ("mass", "inertia", "status")}
     attrs.pop("message", None)
@@ -458,10 +473,8 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
         for name in ("R", "Y", "q") if first[name] is not None
     }  # fmt: skip
     times = np.append(times, t_end) if final else times
-    n_recorded = np.where(failed < 0, len(times), 1 + counts)
-    for k in np.flatnonzero(failed >= 0):
-        for array in samples.values():
-            array[k, n_recorded[k] :] = np.nan
+    n_recorded, t_last = _end_stopped_bodies(samples, last, times, counts, failed,
+                                             (t0, t_end, h, n))  # fmt: skip
     Ys = samples["Y"]
     return BatchTrajectory(
         t=times,
@@ -477,7 +490,32 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
         n_steps=np.where(failed < 0, n, failed - 1),
         n_recorded=n_recorded,
         q_raw=samples.get("q"),
+        t_last=t_last,
     )
+
+
+def _end_stopped_bodies(samples, last, times, counts, failed, grid):
+    """Per body: how many samples are valid, and the time of the last one.
+
+    A stopped body keeps, as :func:`~tumble.rigid.simulate` does, its last finite state (left
+    in ``last`` by the kernel) as its last sample: in the row after its recorded ones, unless
+    the last recorded sample is that state already (same time). The rows after are NaN.
+    ``grid`` is ``(t0, t_end, h, n)``.
+    """
+    t0, t_end, h, n = grid
+    n_recorded = np.full(len(failed), len(times))
+    t_last = np.full(len(failed), times[-1])
+    for k in np.flatnonzero(failed >= 0):
+        done = int(failed[k]) - 1  # steps completed
+        t_last[k] = t_end if done == n else t0 + done * h  # simulate's time of that state
+        n_recorded[k] = 1 + counts[k]
+        if times[counts[k]] != t_last[k]:
+            for name, array in samples.items():
+                array[k, n_recorded[k]] = last[name][k]
+            n_recorded[k] += 1
+        for array in samples.values():
+            array[k, n_recorded[k] :] = np.nan
+    return n_recorded, t_last
 
 
 def _messages(failed: np.ndarray, t0: float, t_end: float, h: float, n: int) -> list[str]:
@@ -489,6 +527,6 @@ def _messages(failed: np.ndarray, t0: float, t_end: float, h: float, n: int) -> 
         t_new = t_end if step == n else t0 + step * h
         messages[k] = (
             f"the state became non-finite (nan or inf) in the step from t={t_old!r} to "
-            f"t={t_new!r}; the samples after the last finite one are NaN"
+            f"t={t_new!r}; the trajectory ends with the last finite state"
         )
     return messages

@@ -81,15 +81,20 @@ def rigid_animations(
         return []
     frames = animation_frames(trajectory)
 
+    # a run stopped by overflow ends in huge, non-rotation matrices: draw them quietly
+    quiet = {"over": "ignore", "invalid": "ignore"} if trajectory.status < 0 else {}
+
     def gif(path: Path) -> None:
         from tumble.viz.animation import animate_body
 
-        animate_body(trajectory, mesh, path, title=title, loads=loads, frames=frames)
+        with np.errstate(**quiet):
+            animate_body(trajectory, mesh, path, title=title, loads=loads, frames=frames)
 
     def html(path: Path) -> None:
         from tumble.viz.html import html_viewer
 
-        html_viewer(trajectory, mesh, path, title=title, loads=loads, frames=frames)
+        with np.errstate(**quiet):
+            html_viewer(trajectory, mesh, path, title=title, loads=loads, frames=frames)
 
     return [("animation.gif", gif), ("view.html", html)]
 

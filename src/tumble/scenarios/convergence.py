@@ -28,7 +28,7 @@ from functools import partial
 import numpy as np
 
 from tumble import exact
-from tumble.rigid import RigidBody, simulate
+from tumble.rigid import METHODS, RigidBody, simulate
 from tumble.scenarios._base import ScenarioResult
 from tumble.viz import rigid
 
@@ -57,6 +57,14 @@ L0 = (float(np.cos(1.1)), 0.0, float(np.sin(1.1)))
 STEP_COUNTS = (200, 400, 800, 1600)
 """Steps over [0, T] by default: h = T/200 … T/1600, inside every method's asymptotic range
 and above round-off for the fourth-order ones."""
+ROUND_OFF_FLOOR = 1e-13
+"""Errors at or below this are round-off, not truncation error, and are left out of the fit.
+
+Double-precision rounding over a run of a few thousand steps leaves ``‖R − R_exact‖_F`` at
+about 1e-15 … 1e-14 whatever h is (``rkmk8`` at the default steps: 5e-15 … 8e-15, a slope of
+0.1); 1e-13 keeps a decade of margin above it."""
+FIXED_STEP_METHODS = tuple(name for name, method in METHODS.items() if not method.adaptive)
+"""The methods that have an observed order in h: every method with a fixed step."""
 
 
 def final_errors(method: str, step_sizes: Sequence[float], *, t_end: float = 10.0) -> np.ndarray:
@@ -65,7 +73,7 @@ def final_errors(method: str, step_sizes: Sequence[float], *, t_end: float = 10.
     Parameters
     ----------
     method : str
-        A fixed-step method of :data:`tumble.rigid.METHODS`.
+        A fixed-step method, one of :data:`FIXED_STEP_METHODS`.
     step_sizes : sequence of float, shape (k,)
         Steps h (s); ``t_end`` should be a multiple of each.
     t_end : float
@@ -76,12 +84,18 @@ def final_errors(method: str, step_sizes: Sequence[float], *, t_end: float = 10.
     ndarray, shape (k,)
         The errors (dimensionless).
 
+    Raises
+    ------
+    ValueError
+        For an adaptive or unknown ``method``.
+
     Examples
     --------
     >>> errors = final_errors("rkmk4", [0.05, 0.025])
     >>> bool(15 < errors[0] / errors[1] < 17)
     True
     """
+    _check_fixed_step("method", method, method)
     body = RigidBody(1.0, INERTIA, allow_unphysical=True)
     reference = exact.free_body_rotation(INERTIA, body.inertia_inverse @ L0, t_end)
     errors = []
@@ -107,16 +121,25 @@ def run(
     step_counts : sequence of int
         Numbers of steps over [0, T], at least two distinct (h = T/n).
     methods : sequence of str
-        Methods to study (default :data:`DEFAULT_METHODS`); those in :data:`CLAIMED_ORDERS`
-        are reported with their claim.
+        Fixed-step methods to study (default :data:`DEFAULT_METHODS`; any of
+        :data:`FIXED_STEP_METHODS`), reported with their claimed order.
 
     Returns
     -------
     ScenarioResult
         ``summary`` with ``h`` (the step sizes, s) and, per method (``results``),
-        ``claimed_order``, ``observed_order``, ``errors`` and ``last_halving_ratio`` (the
-        error at the second-finest h over the error at the finest: 2^order when they differ
-        by a factor 2, as by default). Figure ``convergence.png``.
+        ``claimed_order``, ``observed_order`` (the slope through the errors above
+        :data:`ROUND_OFF_FLOOR`; None when fewer than two are), ``errors``, ``fitted`` (how
+        many errors the slope was fitted through), ``note`` (None, or why errors were left
+        out) and ``last_halving_ratio`` (the error at the second-finest h over the error at
+        the finest: 2^order when they differ by a factor 2, as by default). Figure
+        ``convergence.png``.
+
+    Raises
+    ------
+    ValueError
+        For no methods, an adaptive or unknown one (``rkmk45`` takes h only as its first
+        step, so its error has no order in h), or fewer than two distinct step counts.
 
     Examples
     --------
@@ -127,6 +150,8 @@ def run(
     methods = (methods,) if isinstance(methods, str) else tuple(methods)
     if not methods:
         raise ValueError("methods=() is not allowed: name at least one method")
+    for method in methods:
+        _check_fixed_step("methods", methods, method)
     counts = np.asarray(step_counts)
     if counts.ndim != 1 or len(set(counts.tolist())) < 2 or np.any(counts < 1):
         raise ValueError(
@@ -144,10 +169,7 @@ def run(
         "L0": list(L0),
         "results": results,
     }
-    studies = [
-        (method, step_sizes, np.array(result["errors"]), result["observed_order"])
-        for method, result in results.items()
-    ]
+    studies = [_plotted(method, step_sizes, result) for method, result in results.items()]
     title = f"{NAME} — I = diag(2, 1, 2/3), L = (cos 1.1, 0, sin 1.1), T = {t_end:g} s"
     writer = partial(rigid.convergence, studies, title=title)
     return ScenarioResult(
@@ -166,25 +188,77 @@ def _dataset(step_sizes: np.ndarray, results: dict):
 
     methods = list(results)
     errors = np.array([results[method]["errors"] for method in methods])
-    orders = np.array([results[method]["observed_order"] for method in methods])
+    orders = [results[method]["observed_order"] for method in methods]
+    orders = np.array([np.nan if order is None else order for order in orders], dtype=float)
     return xr.Dataset(
         {
             "error": (("method", "h"), errors, {"units": "1", "long_name": "|R(T) − R_exact|_F"}),
-            "observed_order": ("method", orders, {"units": "1"}),
+            "observed_order": (
+                "method",
+                orders,
+                {"units": "1", "description": "NaN: every error at round-off, no order"},
+            ),
         },
         coords={"method": methods, "h": ("h", step_sizes, {"units": "s"})},
+    )
+
+
+def _check_fixed_step(argument: str, value, method) -> None:
+    """A ValueError naming ``argument`` unless ``method`` is a fixed-step method."""
+    if method in FIXED_STEP_METHODS:
+        return
+    if isinstance(method, str) and method in METHODS:
+        why = "is adaptive: h is only its first step, so its error has no order in h"
+    else:
+        why = "is not a rigid-body method"
+    raise ValueError(
+        f"{argument}={value!r}: {method!r} {why}; choose fixed-step methods from "
+        f"{list(FIXED_STEP_METHODS)}"
     )
 
 
 def _study(method: str, step_sizes: np.ndarray, t_end: float) -> dict:
     errors = final_errors(method, step_sizes, t_end=t_end)
     finest = np.argsort(step_sizes)[:2]
+    above = errors > ROUND_OFF_FLOOR
+    left_out = int(np.count_nonzero(~above))
+    order, note = None, None
+    if np.unique(step_sizes[above]).size >= 2:
+        order = exact.observed_order(step_sizes[above], errors[above])
+        if left_out:
+            note = (
+                f"{left_out} of {errors.size} errors are at round-off (≤ {ROUND_OFF_FLOOR:g}) "
+                "and are left out of the fit"
+            )
+    else:
+        note = (
+            f"{left_out} of {errors.size} errors are at round-off (≤ {ROUND_OFF_FLOOR:g}): "
+            "too few above it for an order; use fewer steps (larger h), e.g. step_counts="
+            f"{HIGH_ORDER_STEP_COUNTS} for rkmk8"
+        )
     return {
         "claimed_order": CLAIMED_ORDERS.get(method),
-        "observed_order": exact.observed_order(step_sizes, errors),
+        "observed_order": order,
         "errors": errors.tolist(),
+        "fitted": int(np.count_nonzero(above)) if order is not None else 0,
+        "note": note,
         "last_halving_ratio": float(errors[finest[1]] / errors[finest[0]]),
     }
+
+
+def _plotted(method: str, step_sizes: np.ndarray, result: dict) -> tuple:
+    """``(label, h, errors, slope)`` for the plot: the fitted errors and their slope.
+
+    A method at round-off has no slope; its errors are drawn on a flat line (slope 0).
+    """
+    errors = np.array(result["errors"])
+    if result["observed_order"] is None:
+        return f"{method} (at round-off, no order)", step_sizes, errors, 0.0
+    above = errors > ROUND_OFF_FLOOR
+    label = (
+        method if above.all() else f"{method} ({np.count_nonzero(~above)} at round-off not shown)"
+    )
+    return label, step_sizes[above], errors[above], result["observed_order"]
 
 
 def free_body() -> tuple[RigidBody, np.ndarray]:

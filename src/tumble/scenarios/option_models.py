@@ -3,8 +3,10 @@
 A scenario may declare its pydantic model as ``OPTIONS`` (``rigid-body`` does: its options
 are nested tables, :mod:`tumble.scenarios.rigid_body`); otherwise :func:`options_model`
 derives one from the signature of its ``run`` — names, types and defaults — with value
-rules looked up by option name: :data:`POSITIVE` (must be > 0) and :data:`METHOD_CHOICES`
-(a method name). Deriving keeps a single source of truth: an option added to a built-in
+rules looked up by option name: :data:`POSITIVE` (must be > 0), :data:`THREE_VECTORS` (lists
+of exactly 3 numbers), :data:`MIN_DISTINCT` (enough distinct values) and
+:data:`METHOD_CHOICES` (a method name). An option whose default is a non-empty sequence must
+be a non-empty list. Deriving keeps a single source of truth: an option added to a built-in
 ``run`` is accepted in files at once, and cannot drift from a hand-written copy.
 
 The types and the messages come from :mod:`tumble.scenarios.schema`;
@@ -25,7 +27,16 @@ from numpy.typing import ArrayLike
 from pydantic import AfterValidator, BaseModel, create_model
 
 from tumble import scenarios
-from tumble.scenarios.schema import Flag, Integer, Number, Section, Text, custom_error, one_of
+from tumble.scenarios.schema import (
+    Flag,
+    Integer,
+    Number,
+    Section,
+    Text,
+    Vector3,
+    custom_error,
+    one_of,
+)
 
 POSITIVE = frozenset(
     {
@@ -36,6 +47,12 @@ POSITIVE = frozenset(
     }
 )  # fmt: skip
 """Options of a built-in scenario that must be > 0 (every number, for a list)."""
+THREE_VECTORS = frozenset({"center", "hit_from", "vertex", "omega0", "spins"})
+"""Options of a built-in scenario made of 3-vectors (a point in m, a direction, an angular
+velocity in rad/s): a list of exactly 3 numbers, or for a list of vectors (``spins``) a list
+of such lists."""
+MIN_DISTINCT = {"step_counts": 2}
+"""Options whose list needs at least this many distinct values (a slope needs two steps)."""
 
 
 def _rigid_methods() -> list[str]:
@@ -44,13 +61,19 @@ def _rigid_methods() -> list[str]:
     return list(METHODS)
 
 
+def _fixed_step_rigid_methods() -> list[str]:
+    from tumble.rigid import METHODS
+
+    return [name for name, method in METHODS.items() if not method.adaptive]
+
+
 def _ode_methods() -> list[str]:
     from tumble.ode import TABLEAUX
 
     return list(TABLEAUX)
 
 
-METHOD_CHOICES = {"projectile": _ode_methods}
+METHOD_CHOICES = {"projectile": _ode_methods, "convergence": _fixed_step_rigid_methods}
 """Where a scenario's ``method``/``methods`` come from; others: :data:`tumble.rigid.METHODS`."""
 
 
@@ -67,13 +90,35 @@ def _positive(value: Any) -> Any:
     return value
 
 
+def _non_empty(value: Any) -> Any:
+    if isinstance(value, list) and not value:
+        raise custom_error("empty", "must have at least one item")
+    return value
+
+
+def _distinct(count: int) -> AfterValidator:
+    """An after-validator: a list of at least ``count`` distinct values."""
+
+    def check(value: Any) -> Any:
+        if isinstance(value, list) and len(set(value)) < count:
+            raise custom_error(
+                "distinct", "must hold at least {count} distinct values", count=count
+            )
+        return value
+
+    return AfterValidator(check)
+
+
 def _is_array_like(annotation: Any) -> bool:
     members = set(typing.get_args(ArrayLike))
     return bool(members) and members <= set(typing.get_args(annotation))
 
 
-def _field_type(annotation: Any, default: Any) -> Any:
-    """The pydantic type of one option: Sequence → list, array_like → nested list."""
+def _field_type(annotation: Any, default: Any, vector: bool = False) -> Any:
+    """The pydantic type of one option: Sequence → list, array_like → nested list.
+
+    With ``vector``, the innermost list of numbers is a :data:`Vector3` (3 numbers).
+    """
     simple = {bool: Flag, int: Integer, float: Number, str: Text}
     if annotation in simple:
         return simple[annotation]
@@ -81,17 +126,18 @@ def _field_type(annotation: Any, default: Any) -> Any:
     optional = type(None) in args
     if _is_array_like(annotation):
         depth = max(1, np.ndim(default)) if default is not None else 1
-        result: Any = Number
-        for _ in range(depth):
+        result: Any = Vector3 if vector else list[Number]
+        for _ in range(depth - 1):
             result = list[result]
         return result | None if optional else result
     origin = typing.get_origin(annotation)
     if origin in (Union, types.UnionType):
-        members = [_field_type(arg, default) for arg in args if arg is not type(None)]
+        members = [_field_type(arg, default, vector) for arg in args if arg is not type(None)]
         result = Union[tuple(members)]  # noqa: UP007 - built from a list
         return result | None if optional else result
     if origin in (list, tuple, Sequence) and args:
-        return list[_field_type(args[0], None)]
+        item = _field_type(args[0], None, vector)
+        return Vector3 if vector and item is Number else list[item]
     return Any
 
 
@@ -99,8 +145,12 @@ def _option(scenario: str, name: str, parameter: inspect.Parameter, annotation: 
     default = parameter.default
     if isinstance(default, tuple):
         default = list(default)
-    kind = _field_type(annotation, default)
+    kind = _field_type(annotation, default, vector=name in THREE_VECTORS)
     checks = []
+    if isinstance(default, list) and default:
+        checks.append(AfterValidator(_non_empty))
+    if name in MIN_DISTINCT:
+        checks.append(_distinct(MIN_DISTINCT[name]))
     if name in POSITIVE:
         checks.append(AfterValidator(_positive))
     if name in ("method", "methods"):
@@ -148,4 +198,4 @@ def _scenario(name: Any):
     return scenarios.get(name)
 
 
-__all__ = ["METHOD_CHOICES", "POSITIVE", "options_model"]
+__all__ = ["METHOD_CHOICES", "MIN_DISTINCT", "POSITIVE", "THREE_VECTORS", "options_model"]

@@ -127,15 +127,17 @@ def run(
     Returns
     -------
     ScenarioResult
-        ``summary["spins"]``: per spin ``omega0``, ``axis`` and ``axis_role``,
+        ``summary["spins"]``: per spin ``omega0``, ``axis`` and ``axis_role``, the run's
+        ``status`` and ``message`` (:class:`~tumble.rigid.Trajectory`'s),
         ``period_closed_form`` and ``period_measured`` (s; None if the run saw fewer than
         three crossings), ``period_relative_difference``, ``measured_from``,
         ``max_orthogonality_error``, ``energy_drift`` (largest ``|E/E₀ − 1|``),
         ``momentum_drift`` (largest ``|L − L₀|/|L₀|``) and ``error_vs_exact``
-        (``‖R − R_exact‖_F`` at the end). Figures: ``rotation_grid_spin<k>.png``,
-        ``euler_angles_spin<k>.png`` for k = 1, 2, …, ``angular_velocity.png``, ``drift.png``;
-        datasets ``spin<k>``; ``animation.gif`` and ``view.html`` of the intermediate-axis
-        spin (the flip).
+        (``‖R − R_exact‖_F`` at the end). A spin that stopped before ``t_end`` (``status``
+        < 0: its state overflowed) has None for all the measured numbers. Figures:
+        ``rotation_grid_spin<k>.png``, ``euler_angles_spin<k>.png`` for k = 1, 2, …,
+        ``angular_velocity.png``, ``drift.png``; datasets ``spin<k>``; ``animation.gif`` and
+        ``view.html`` of the intermediate-axis spin (the flip).
 
     Examples
     --------
@@ -173,9 +175,7 @@ def run(
         ),
         attrs=rigid_attrs(body, method=method, h=h, rtol=rtol, t_end=t_end),
         animations=rigid_animations(
-            runs[shown],
-            mesh,
-            title=f"{NAME} — {_label(summary['spins'][shown])}\n{setting}",
+            runs[shown], mesh, title=f"{NAME} — {_label(summary['spins'][shown])}\n{setting}"
         ),
     )
 
@@ -193,29 +193,50 @@ def _role(inertia: np.ndarray, omega0: np.ndarray) -> tuple[str, str]:
     return _AXES[axis], _ROLES[rank]
 
 
+_MEASURED = (
+    "period_measured",
+    "period_relative_difference",
+    "max_orthogonality_error",
+    "energy_drift",
+    "momentum_drift",
+    "error_vs_exact",
+)
+"""The numbers of a spin measured from its run: None when the run stopped before ``t_end``."""
+
+
 def _spin_result(body: RigidBody, omega0: np.ndarray, run: Trajectory) -> tuple[dict, np.ndarray]:
     closed_form = exact.free_body_period(body.inertia, omega0)
-    period, component, crossings = measured_period(run.t, run.omega_body)
     axis, role = _role(body.inertia, omega0)
+    with np.errstate(all="ignore"):  # a diverged run: inf or nan, reported by its status
+        period, component, crossings = measured_period(run.t, run.omega_body)
+        result = {
+            "omega0": omega0.tolist(),
+            "axis": axis,
+            "axis_role": role,
+            "status": run.status,
+            "message": run.message,
+            "period_closed_form": closed_form,
+            "period_measured": period,
+            "period_relative_difference": None if period is None else period / closed_form - 1,
+            "measured_from": f"omega_{_AXES[component]}",
+            **_drifts(body, omega0, run),
+        }
+    if run.status < 0:
+        result.update(dict.fromkeys(_MEASURED))
+    return result, crossings
+
+
+def _drifts(body: RigidBody, omega0: np.ndarray, run: Trajectory) -> dict:
+    """Orthogonality, energy and momentum drift, and the final error against the exact R."""
     L0 = run.L_world[0]
-    with np.errstate(all="ignore"):
-        energy_drift = np.max(np.abs(run.energy / run.energy[0] - 1.0))
-        momentum = np.max(np.linalg.norm(run.L_world - L0, axis=1)) / np.linalg.norm(L0)
     R_exact = exact.free_body_rotation(body.inertia, omega0, run.t[-1])
-    result = {
-        "omega0": omega0.tolist(),
-        "axis": axis,
-        "axis_role": role,
-        "period_closed_form": closed_form,
-        "period_measured": period,
-        "period_relative_difference": None if period is None else period / closed_form - 1,
-        "measured_from": f"omega_{_AXES[component]}",
+    momentum = np.linalg.norm(run.L_world - L0, axis=1) / np.linalg.norm(L0)
+    return {
         "max_orthogonality_error": float(np.max(run.orthogonality_error)),
-        "energy_drift": float(energy_drift),
-        "momentum_drift": float(momentum),
+        "energy_drift": float(np.max(np.abs(run.energy / run.energy[0] - 1.0))),
+        "momentum_drift": float(np.max(momentum)),
         "error_vs_exact": float(np.linalg.norm(run.R[-1] - R_exact)),
     }
-    return result, crossings
 
 
 def _label(spin: dict) -> str:
@@ -225,7 +246,12 @@ def _label(spin: dict) -> str:
 
 def _period_note(spin: dict) -> str:
     measured = spin["period_measured"]
-    shown = "not measured (run longer)" if measured is None else f"{measured:.4f} s"
+    if spin["status"] < 0:
+        shown = "not measured (the run stopped early: its state overflowed)"
+    elif measured is None:
+        shown = "not measured (run longer)"
+    else:
+        shown = f"{measured:.4f} s"
     closed = spin["period_closed_form"]
     return f"period from {spin['measured_from']}: {shown} (closed form {closed:.4f} s)"
 
