@@ -7,6 +7,7 @@ import logging
 import numpy as np
 
 from tumble import so3
+from tumble._progress import progress_bar
 from tumble.ode.control import StepController, error_norm, minimum_step
 from tumble.ode.events import EventTracker
 from tumble.ode.solve import fixed_step_count
@@ -14,7 +15,6 @@ from tumble.rigid import initial
 from tumble.rigid.body import RigidBody
 from tumble.rigid.forces import State, compiled_loads, split_loads
 from tumble.rigid.methods import Method, get_method
-from tumble.rigid.progress import progress_bar
 from tumble.rigid.steppers import Dynamics, step
 from tumble.rigid.trajectory import Trajectory
 
@@ -200,7 +200,12 @@ def _integrate(run: _Run, t_end, h, rtol, atol, impulses, events, loads, progres
     """Integrate segment by segment (split at impulses); return the event times."""
     tracker = _Events(events, run) if events else None
     segments, finals = _segments(run.t, t_end, impulses)
-    with progress_bar(progress, run.t, t_end) as advance:
+    t0 = run.t
+    with progress_bar(progress, t_end - t0, "simulating") as update:
+
+        def advance(t: float) -> None:
+            update(completed=t - t0)
+
         for a, b, kicks in segments:
             run.kick(kicks)
             if loads is not None:

@@ -52,14 +52,14 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
+from tumble._progress import progress_bar
 from tumble.structural import stepping, validation
 from tumble.structural.factorization import MAX_BANDWIDTH, band_structure, banded_cholesky
 from tumble.structural.stepping import Increments, State
@@ -299,7 +299,11 @@ def integrate(
     block = stepping.block_size(n_steps, PROGRESS_UPDATES if progress else 1)
     if not progress:  # one call per ~BLOCK_WORK DOF-steps: Ctrl-C is seen between calls
         block = min(block, max(1, BLOCK_WORK // system.n_dofs))
-    with _progress_bar(progress, n_steps, scheme.name) as advance, _quiet_overflow():
+    with progress_bar(progress, n_steps, scheme.name) as update, _quiet_overflow():
+
+        def advance(count: int) -> None:
+            update(advance=count)
+
         xs, ys, row, diverged = run(
             system, scheme.increments(dt), factor, C, state, steps, advance, block
         )
@@ -354,18 +358,6 @@ def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | N
             raise ValueError(f"{name} must have shape ({system.n_dofs},); got {array.shape}")
         start.append(array.astype(float, copy=True))
     return State.start(system, *start)
-
-
-@contextmanager
-def _progress_bar(enabled: bool, total: int, description: str) -> Iterator[Callable[[int], None]]:
-    if not enabled:
-        yield lambda n: None
-        return
-    from rich.progress import Progress
-
-    with Progress(transient=True) as bar:
-        task = bar.add_task(description, total=total)
-        yield lambda n: bar.advance(task, n)
 
 
 def _quiet_overflow() -> contextlib.AbstractContextManager:

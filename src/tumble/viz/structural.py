@@ -93,7 +93,7 @@ def stability_figure(sweeps: Sequence[StabilitySweep], *, title: str) -> Figure:
     axes.axhline(1.0, color="0.5", lw=0.8)
     axes.set_xlabel("time step Δt [s]")
     axes.set_ylabel("max (E − E₀) / energy scale  [–]")
-    axes.set_title(f"{title} (diverged runs at {top:.0e}, dashed: 2/ω_max)", fontsize=10)
+    axes.set_title(f"{title}\n(diverged runs drawn at {top:.0e}; dashed: 2/ω_max)", fontsize=10)
     axes.legend(fontsize=8)
     axes.grid(alpha=0.3, which="both")
     return figure
