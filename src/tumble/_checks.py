@@ -1,0 +1,134 @@
+"""Input checks: one module, one message grammar.
+
+Every check raises :class:`ValueError` with a message of one form,
+
+    ``{name}={value!r} is not allowed: must be {what is allowed} ({unit}); {remedy}``
+
+naming the argument, the value, what is allowed and the unit (the unit and the remedy only
+where there is one). "Positive" always means finite and > 0: an infinite step, mass or
+tolerance is refused like a negative one.
+
+Examples
+--------
+>>> positive("h", 0.01, "s")
+0.01
+>>> positive("h", -0.1, "s")
+Traceback (most recent call last):
+...
+ValueError: h=-0.1 is not allowed: must be finite and > 0 (s)
+>>> count("record_every", 0)
+Traceback (most recent call last):
+...
+ValueError: record_every=0 is not allowed: must be an integer >= 1
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Iterable, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+
+def fail(name: str, value: object, allowed: str, unit: str = "", remedy: str = "") -> ValueError:
+    """The ValueError of this module's grammar (returned, for the caller to raise).
+
+    Examples
+    --------
+    >>> str(fail("method", "rk5", "one of 'rk4', 'dopri5'", remedy="see tumble.ode.TABLEAUX"))
+    "method='rk5' is not allowed: must be one of 'rk4', 'dopri5'; see tumble.ode.TABLEAUX"
+    """
+    message = f"{name}={value!r} is not allowed: must be {allowed}"
+    if unit:
+        message += f" ({unit})"
+    if remedy:
+        message += f"; {remedy}"
+    return ValueError(message)
+
+
+def _real(value: object) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def positive(name: str, value: object, unit: str = "", remedy: str = "") -> float:
+    """``value`` as a float, after checking it is a finite real number > 0."""
+    if not (_real(value) and math.isfinite(value) and value > 0):  # type: ignore[arg-type]
+        raise fail(name, value, "finite and > 0", unit, remedy)
+    return float(value)  # type: ignore[arg-type]
+
+
+def non_negative(name: str, value: object, unit: str = "", remedy: str = "") -> float:
+    """``value`` as a float, after checking it is a finite real number >= 0."""
+    if not (_real(value) and math.isfinite(value) and value >= 0):  # type: ignore[arg-type]
+        raise fail(name, value, "finite and >= 0", unit, remedy)
+    return float(value)  # type: ignore[arg-type]
+
+
+def finite(name: str, value: object, unit: str = "", remedy: str = "") -> float:
+    """``value`` as a float, after checking it is a finite real number."""
+    if not (_real(value) and math.isfinite(value)):  # type: ignore[arg-type]
+        raise fail(name, value, "a finite number", unit, remedy)
+    return float(value)  # type: ignore[arg-type]
+
+
+def count(name: str, value: object, minimum: int = 1) -> int:
+    """``value`` as an int, after checking it is an integer ``>= minimum`` (bools refused)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
+        raise fail(name, value, f"an integer >= {minimum}")
+    return int(value)
+
+
+def choice(name: str, value: object, allowed: Iterable[str], remedy: str = "") -> str:
+    """``value``, after checking it is one of the ``allowed`` names.
+
+    Examples
+    --------
+    >>> choice("scheme", "rk4", ["explicit", "midpoint"])
+    Traceback (most recent call last):
+    ...
+    ValueError: scheme='rk4' is not allowed: must be one of 'explicit', 'midpoint'
+    """
+    names = list(allowed)
+    if not isinstance(value, str) or value not in names:
+        raise fail(name, value, "one of " + ", ".join(map(repr, names)), remedy=remedy)
+    return value
+
+
+def array(
+    name: str,
+    value: ArrayLike,
+    *,
+    shape: Sequence[int] | None = None,
+    unit: str = "",
+    positive: bool = False,
+) -> NDArray[np.float64]:
+    """``value`` as a float array (a copy), every entry finite (and > 0 if ``positive``).
+
+    ``shape`` is the shape required, if any. The message names the first bad entry.
+
+    Examples
+    --------
+    >>> array("x0", [0.0, 1.0], shape=(3,), unit="m")
+    Traceback (most recent call last):
+    ...
+    ValueError: x0=[0.0, 1.0] is not allowed: must be of shape (3,), every entry finite (m)
+    """
+    wanted = "every entry finite and > 0" if positive else "every entry finite"
+    if shape is not None:
+        wanted = f"of shape {tuple(shape)}, {wanted}"
+    try:
+        result = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise fail(name, value, wanted, unit) from None
+    if shape is not None and result.shape != tuple(shape):
+        raise fail(name, value, wanted, unit)
+    good = np.isfinite(result) & (result > 0) if positive else np.isfinite(result)
+    if not np.all(good):
+        if result.ndim == 0:
+            raise fail(name, value, wanted, unit)
+        index = tuple(int(i) for i in np.argwhere(~good)[0])
+        label = f"{name}[{', '.join(map(str, index))}]"
+        raise fail(label, float(result[index]), wanted.replace("every entry ", ""), unit)
+    return result
