@@ -241,18 +241,18 @@ def kernel_run(problem: Problem, method: str, h: float) -> np.ndarray:
     """``method``'s steps alone: the ``lie``-family kernel called directly, without
     ``simulate``'s checks, initial state and trajectory (the floor of a ``simulate`` call);
     returns R(T)."""
+    from tumble.ode.driver import Grid
     from tumble.rigid import kernels
+    from tumble.rigid.charts import LIE
     from tumble.rigid.methods import METHODS
 
     tableau = METHODS[method].tableau
     n, zero, none = round(T_END / h), np.zeros(3), np.zeros((0, 3))
-    z, Rn = kernels.pack(
-        "lie", np.eye(3), np.concatenate([zero, zero, problem.omega0 * problem.inertia])
-    )
-    record = (np.empty(1), np.empty((1, 3, 3)), np.empty((1, 4)), np.empty((1, 9)))
-    kernels.run_fixed("lie", True, tableau.A, tableau.b, z, Rn, 0.0, h, 0, n, n, T_END,
-                      problem.body.inertia_inverse, problem.body.mass, zero, zero, none, none,
-                      10**9, 0, *record)  # fmt: skip
+    z, Rn = LIE.pack(np.eye(3), np.concatenate([zero, zero, problem.omega0 * problem.inertia]))
+    data = kernels.Problem(True, tableau.A, tableau.b, problem.body.inertia_inverse,
+                           problem.body.mass, zero, zero, none, none)  # fmt: skip
+    record = kernels.Records(np.empty(1), np.empty((1, 3, 3)), np.empty((1, 4)), np.empty((1, 9)))
+    kernels.COMPILED["lie"].loop(data, Grid(0.0, T_END, h, n), z, Rn, 0, n, 10**9, 0, record)
     return Rn
 
 

@@ -22,7 +22,7 @@ def test_missing_step_for_fixed_method_is_refused():
 
 
 def test_unknown_method_lists_the_known_ones():
-    with pytest.raises(ValueError, match=r"method='rk5'.*\['dopri5', 'euler'"):
+    with pytest.raises(ValueError, match=r"method='rk5'.*one of 'euler', 'heun'"):
         solve(decay, (0, 1), [1.0], method="rk5", h=0.1)
 
 
@@ -50,7 +50,7 @@ def test_reversed_empty_or_bad_span_is_refused(t_span):
 
 @pytest.mark.parametrize("y0", [[np.nan], [1.0, np.inf], [], [[1.0]]])
 def test_non_finite_or_malformed_initial_state_is_refused(y0):
-    with pytest.raises(ValueError, match="y0="):
+    with pytest.raises(ValueError, match=r"y0(\[\d+\])?="):
         solve(decay, (0, 1), y0, h=0.1)
 
 

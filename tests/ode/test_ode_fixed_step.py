@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from tumble import solve
-from tumble.ode.solve import fixed_step_count
+from tumble.ode.control import fixed_step_count
 
 
 def test_step_that_divides_the_span_gives_that_many_steps():

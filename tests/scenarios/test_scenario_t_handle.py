@@ -119,7 +119,7 @@ def test_a_diverged_spin_reports_its_status_and_no_measured_numbers(diverged):
 
 def test_spins_that_reach_t_end_report_status_zero(result):
     for spin in result.summary["spins"]:
-        assert (spin["status"], spin["message"]) == (0, "The simulation reached t_end.")
+        assert (spin["status"], spin["message"]) == (0, "The run reached the end of the interval.")
 
 
 def test_a_diverged_spin_still_writes_its_run_folder_without_warnings(diverged, tmp_path):

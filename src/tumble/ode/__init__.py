@@ -8,11 +8,14 @@
 :func:`rk_step`        one explicit Runge–Kutta step, for any tableau
 :class:`StepController`  accept/reject and the next step size
 :class:`DenseOutput`   the continuous solution of a run
+:func:`march`          the one stepping driver every time loop of tumble runs on
+:class:`Status`        how a run ended (``SUCCESS``, ``TERMINAL_EVENT``, ``FAILED``)
 =====================  ===========================================================
 """
 
 from tumble.ode.control import StepController, error_norm
 from tumble.ode.dense import DenseOutput
+from tumble.ode.driver import Status, Stepper, march
 from tumble.ode.solve import OdeResult, solve
 from tumble.ode.stepper import rk_step
 from tumble.ode.tableaux import TABLEAUX, ButcherTableau
@@ -22,8 +25,11 @@ __all__ = [
     "ButcherTableau",
     "DenseOutput",
     "OdeResult",
+    "Status",
     "StepController",
+    "Stepper",
     "error_norm",
+    "march",
     "rk_step",
     "solve",
 ]

@@ -91,6 +91,31 @@ class StepController:
         return accepted, h * factor
 
 
+def fixed_step_count(t0: float, t1: float, h: float) -> int:
+    """Number of steps of size ``h`` (the last one shortened) that cover ``[t0, t1]``.
+
+    A ratio within round-off of an integer counts as that integer, so ``h = 0.1`` on
+    ``[0, 1]`` takes 10 steps, not 11. Step ``k`` ends at ``t0 + k h``, the last at ``t1``
+    exactly (:func:`grid_time`).
+
+    Examples
+    --------
+    >>> fixed_step_count(0.0, 1.0, 0.1), fixed_step_count(0.0, 1.0, 0.3)
+    (10, 4)
+    """
+    ratio = (t1 - t0) / h
+    nearest = round(ratio)
+    if nearest >= 1 and abs(ratio - nearest) <= 1e-9 * max(1.0, ratio):
+        return int(nearest)
+    return max(1, math.ceil(ratio))
+
+
+def grid_time(t0: float, t1: float, h: float, k: int, n: int) -> float:
+    """Where step ``k`` of the ``n`` steps of :func:`fixed_step_count` ends: ``t0 + k h``,
+    or ``t1`` exactly for the last."""
+    return t1 if k == n else t0 + k * h
+
+
 def minimum_step(t: float) -> float:
     """The smallest step that still moves ``t``: ten units in the last place."""
     return 10.0 * math.ulp(t)

@@ -16,13 +16,14 @@ from functools import cached_property
 
 import numpy as np
 
-from tumble import so3
-from tumble.ode.solve import fixed_step_count
+from tumble import _checks, so3
+from tumble.ode.control import fixed_step_count
+from tumble.ode.driver import Block, Grid, Status, Stepper, march, non_finite_message
 from tumble.rigid import initial
 from tumble.rigid.body import RigidBody
+from tumble.rigid.charts import CHARTS
 from tumble.rigid.forces import compiled_loads, split_loads
-from tumble.rigid.kernels import FAMILY_CODES, run_batch
-from tumble.rigid.methods import METHODS, get_method
+from tumble.rigid.methods import METHODS, Method, get_method
 from tumble.rigid.trajectory import Trajectory
 
 FIXED_METHODS = [name for name, method in METHODS.items() if not method.adaptive]
@@ -50,6 +51,7 @@ class BatchTrajectory:
     settings : dict
         ``h``, ``record_every``, as :class:`~tumble.rigid.trajectory.Trajectory`'s.
     status : ndarray of int, shape (N,)
+        Per body, a :class:`~tumble.ode.driver.Status` code.
         0: reached ``t_end``; -1: stopped by a non-finite state. A stopped body ends, as in
         :func:`~tumble.rigid.simulate`, with its last finite state (at ``t_last``); its rows
         after that one are NaN.
@@ -101,7 +103,7 @@ class BatchTrajectory:
             body=self.bodies[k],
             method=self.method,
             settings=dict(self.settings),
-            status=int(self.status[k]),
+            status=Status(int(self.status[k])),
             message=self.messages[k],
             n_steps=int(self.n_steps[k]),
             q_raw=None if self.q_raw is None else self.q_raw[k, :n],
@@ -304,17 +306,11 @@ def _kernel_loads(forces, bodies):
     return F, tau, points, point_forces
 
 
-def _record_times(t0: float, t_end: float, h: float, n: int, every: int) -> np.ndarray:
+def _record_times(grid: Grid, every: int) -> np.ndarray:
     """The kernel's sample times ``t_old + h_k`` at steps ``every, 2 every, …`` (exactly)."""
-    k = np.arange(every, n + 1, every)
-    t_old = t0 + (k - 1) * h
-    return t_old + (np.where(k == n, t_end, t0 + k * h) - t_old)
-
-
-def _check_record_every(record_every) -> int:
-    if not (isinstance(record_every, int | np.integer) and record_every >= 1):
-        raise ValueError(f"record_every={record_every!r} must be a positive integer")
-    return int(record_every)
+    k = np.arange(every, grid.n + 1, every)
+    t_old = grid.t0 + (k - 1) * grid.h
+    return t_old + (np.where(k == grid.n, grid.t1, grid.t0 + k * grid.h) - t_old)
 
 
 def simulate_batch(
@@ -353,8 +349,8 @@ def simulate_batch(
     t_end : float
         End time (s), > ``t0``; the last step lands on it.
     method : str
-        A fixed-step method: ``"euler"``, ``"lie-euler"``, ``"rk4-matrix"``, ``"rk4-quat"``,
-        ``"seed-rk4"``, ``"rkmk4"`` (default) or ``"rkmk8"``.
+        A fixed-step method of :data:`tumble.rigid.METHODS` (:data:`FIXED_METHODS`; default
+        ``"rkmk4"``).
     h : float
         Step (s).
     t0 : float
@@ -412,7 +408,7 @@ def simulate_batch(
         )
     t0, t_end = initial.check_times(t0, t_end)
     h, _, _ = initial.check_steps(spec, h, None, None)
-    every = _check_record_every(record_every)
+    every = _checks.count("record_every", record_every)
     if list(events):
         raise ValueError("simulate_batch does not locate events; use tumble.simulate for events")
     bodies, one_body = _bodies(body_or_bodies)
@@ -427,57 +423,80 @@ def simulate_batch(
     return _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings)
 
 
-def _pack(family: str, R: np.ndarray, Y: np.ndarray):
-    """The kernel's ``(Z, RN)`` for every body, and the attitudes of the first sample."""
-    n = len(R)
-    if family == "lie":
-        return np.concatenate([np.zeros((n, 3)), Y], axis=1), R.copy(), R
-    RN = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
-    if family == "quat":
-        q = so3.quat_from_matrix(R)
-        return np.concatenate([q, Y], axis=1), RN, so3.matrix_from_quat(q)
-    return np.concatenate([R.reshape(n, 9), Y], axis=1), RN, R
+class BatchStepper(Stepper):
+    """Every body of a batch in the chart's compiled batch loop, as one block of the driver.
+
+    The state is ``(attitude, Y)`` with a leading body axis; samples are stacked along axis 1
+    (time). A body whose state stops being finite stops alone: the block goes on for the
+    others, and :attr:`counts` and :attr:`failed` say, per body, how many samples it
+    recorded and at which step it stopped (-1: none).
+    """
+
+    blocks = True
+    time_axis = 1
+
+    def __init__(self, method: Method, problem):
+        from tumble.rigid.kernels import COMPILED
+
+        self.chart, self.problem = CHARTS[method.family], problem
+        self.batch = COMPILED[self.chart.name].batch
+        self._quat = self.chart.name == "quat"
+        self.counts = self.failed = np.zeros(0, dtype=np.int64)
+
+    def start(self, R: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.chart.attitude(R), Y
+
+    def record(self, state) -> tuple:
+        attitude, Y = state
+        q = attitude[:, None] if self._quat else np.empty((len(Y), 1, 0))
+        return self.chart.matrix(attitude)[:, None], Y[:, None], q
+
+    def march_block(self, state, grid: Grid, k0: int, k1: int, every: int, step0: int) -> Block:
+        from tumble.rigid.kernels import Records
+
+        if (k0, k1, step0) != (0, grid.n, 0):
+            raise NotImplementedError("a batch marches its whole grid in one block")
+        n_bodies, size = len(state[1]), grid.n // every  # samples at steps every, 2 every, …
+        records = Records(*(np.empty((n_bodies, size, *shape)) for shape in RECORD_SHAPES))
+        self.counts = np.zeros(n_bodies, dtype=np.int64)
+        self.failed = np.zeros(n_bodies, dtype=np.int64)
+        Z, RN = self.chart.pack(*state)
+        self.batch(self.problem, grid, Z, RN, every, records, self.counts, self.failed)
+        q = records.q if self._quat else np.empty((n_bodies, size, 0))
+        return Block(
+            t=_record_times(grid, every),
+            records=(records.R, records.Y, q),
+            state=self.chart.read(Z, RN),
+        )
 
 
-def _unpack(family: str, Z: np.ndarray, RN: np.ndarray):
-    """Final ``(R, q or None, Y)`` of every body."""
-    if family == "lie":
-        return RN, None, Z[:, 3:]
-    if family == "quat":
-        return so3.matrix_from_quat(Z[:, :4]), Z[:, :4], Z[:, 4:]
-    return Z[:, :9].reshape(-1, 3, 3), None, Z[:, 9:]
+RECORD_SHAPES = ((), (3, 3), (4,), (9,))
+"""Shapes of one sample in the kernels' ``Records``: t, R, q, Y."""
 
 
 def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTrajectory:
     """Run the kernel for every body; lay the samples out as (body, time, …) arrays."""
+    from tumble.rigid.kernels import Problem
+
     F, tau, points, point_forces = loads
-    family, n_bodies = spec.family, len(bodies)
-    n = fixed_step_count(t0, t_end, h)
-    size = n // every  # samples the kernel takes: steps every, 2 every, …
-    Z, RN, R_first = _pack(family, R, Y)
-    first = {"R": R_first, "Y": Y, "q": Z[:, :4].copy() if family == "quat" else None}
-    shapes = {"t": (), "R": (3, 3), "q": (4,), "Y": (9,)}
-    recorded = {name: np.empty((n_bodies, size, *shape)) for name, shape in shapes.items()}
-    counts, failed = np.zeros(n_bodies, dtype=np.int64), np.zeros(n_bodies, dtype=np.int64)
     mass = _per_body(bodies, lambda body: body.mass)
-    run_batch(FAMILY_CODES[family], spec.dexpinv, spec.tableau.A, spec.tableau.b, Z, RN, t0, h,
-              n, t_end, _per_body(bodies, lambda body: body.inertia_inverse), mass, F, tau,
-              points, point_forces, every, recorded["t"], recorded["R"], recorded["q"],
-              recorded["Y"], counts, failed)  # fmt: skip
-    times = np.concatenate([[t0], _record_times(t0, t_end, h, n, every)])
-    final = times[-1] != t_end  # as simulate: add the end state unless the last sample is it
-    last = dict(zip(("R", "q", "Y"), _unpack(family, Z, RN), strict=True))
-    samples = {
-        name: np.concatenate([first[name][:, None], recorded[name]]
-                             + ([last[name][:, None]] if final else []), axis=1)
-        for name in ("R", "Y", "q") if first[name] is not None
-    }  # fmt: skip
-    times = np.append(times, t_end) if final else times
-    n_recorded, t_last = _end_stopped_bodies(samples, last, times, counts, failed,
-                                             (t0, t_end, h, n))  # fmt: skip
+    inv_I = _per_body(bodies, lambda body: body.inertia_inverse)
+    tableau = spec.tableau
+    problem = Problem(spec.dexpinv, tableau.A, tableau.b, inv_I, mass, F, tau, points,
+                      point_forces)  # fmt: skip
+    stepper = BatchStepper(spec, problem)
+    out = march(stepper, (t0, t_end), stepper.start(R, Y), h=h, record_every=every)
+    names = ("R", "Y", "q") if spec.family == "quat" else ("R", "Y")
+    samples = dict(zip(names, out.records, strict=False))
+    last = {
+        name: record[:, 0] for name, record in zip(names, stepper.record(out.state), strict=False)
+    }
+    grid = Grid(t0, t_end, h, fixed_step_count(t0, t_end, h))
+    failed = stepper.failed
+    n_recorded, t_last = _end_stopped_bodies(samples, last, out.t, stepper.counts, failed, grid)
     Ys = samples["Y"]
     return BatchTrajectory(
-        t=times,
+        t=out.t,
         x=Ys[..., :3],
         v=Ys[..., 3:6] / mass[:, None, None],
         R=samples["R"],
@@ -485,9 +504,9 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
         bodies=bodies,
         method=spec.name,
         settings=settings,
-        status=np.where(failed < 0, 0, -1),
-        messages=_messages(failed, t0, t_end, h, n),
-        n_steps=np.where(failed < 0, n, failed - 1),
+        status=np.where(failed < 0, Status.SUCCESS, Status.FAILED),
+        messages=_messages(failed, grid),
+        n_steps=np.where(failed < 0, grid.n, failed - 1),
         n_recorded=n_recorded,
         q_raw=samples.get("q"),
         t_last=t_last,
@@ -500,14 +519,13 @@ def _end_stopped_bodies(samples, last, times, counts, failed, grid):
     A stopped body keeps, as :func:`~tumble.rigid.simulate` does, its last finite state (left
     in ``last`` by the kernel) as its last sample: in the row after its recorded ones, unless
     the last recorded sample is that state already (same time). The rows after are NaN.
-    ``grid`` is ``(t0, t_end, h, n)``.
+    ``grid`` is the run's :class:`~tumble.ode.driver.Grid`.
     """
-    t0, t_end, h, n = grid
     n_recorded = np.full(len(failed), len(times))
     t_last = np.full(len(failed), times[-1])
     for k in np.flatnonzero(failed >= 0):
         done = int(failed[k]) - 1  # steps completed
-        t_last[k] = t_end if done == n else t0 + done * h  # simulate's time of that state
+        t_last[k] = grid.time(done)  # simulate's time of that state
         n_recorded[k] = 1 + counts[k]
         if times[counts[k]] != t_last[k]:
             for name, array in samples.items():
@@ -518,15 +536,10 @@ def _end_stopped_bodies(samples, last, times, counts, failed, grid):
     return n_recorded, t_last
 
 
-def _messages(failed: np.ndarray, t0: float, t_end: float, h: float, n: int) -> list[str]:
+def _messages(failed: np.ndarray, grid: Grid) -> list[str]:
     """Per body, ``simulate``'s message: the end reached, or the step that was not finite."""
-    messages = ["The simulation reached t_end."] * len(failed)
+    messages = [Status.SUCCESS.message] * len(failed)
     for k in np.flatnonzero(failed >= 0):
         step = int(failed[k])
-        t_old = t0 + (step - 1) * h
-        t_new = t_end if step == n else t0 + step * h
-        messages[k] = (
-            f"the state became non-finite (nan or inf) in the step from t={t_old!r} to "
-            f"t={t_new!r}; the trajectory ends with the last finite state"
-        )
+        messages[k] = non_finite_message(grid.time(step - 1), grid.time(step))
     return messages

@@ -1,20 +1,12 @@
-"""Compiled (numba) fixed-step loops: the same algorithm as :mod:`tumble.rigid.steppers`.
+"""Compiled (numba) fixed-step loops: each chart of :mod:`tumble.rigid.charts`, compiled.
 
-One loop, :func:`run_fixed`, runs every fixed-step method for constant loads: a stage loop
-over the tableau (``A``, ``b`` as arrays), the family's vector field in a chart, and the
-family's map back. A family is three compiled functions (field, advance, record), and
-:func:`_compile_loop` compiles the loop once per family with that family's functions inlined
-(the other families' branches are dropped at compile time):
-
-=========  ==========================  ==========================  ===========================
-family     ``z``                       vector field                map back
-=========  ==========================  ==========================  ===========================
-matrix     ``(vec R, x, p, L)``        ``Ṙ = R ω̂``                 nothing
-quat       ``(q, x, p, L)``            ``q̇ = ½ q ⊗ (0, ω)``        ``q ← q/|q|``
-lie        ``(u, x, p, L)``            ``u̇ = dexp⁻¹_{−u}(ω)``      ``R_n ← R_n exp(û)``, u ← 0
-=========  ==========================  ==========================  ===========================
-
-with ``ω = I⁻¹ Rᵀ L``, ``ẋ = p/m``, ``ṗ = F``, ``L̇ = τ + Σ (R r_k) × f_k``.
+One loop, :func:`_loop`, runs every fixed-step method for constant loads: a stage loop over
+the tableau (``A``, ``b`` as arrays), the chart's vector field, and the chart's map back. A
+chart's compiled twin is three functions (field, advance, record), and :func:`_for_chart`
+compiles the loop once per chart with that chart's functions inlined (:data:`COMPILED`),
+and a parallel loop over bodies for :func:`~tumble.rigid.simulate_batch`. The run's data
+travel in one :class:`Problem`, its samples in one :class:`Records`, its grid in the
+driver's :class:`~tumble.ode.driver.Grid`.
 
 Why it is fast: the fields work on scalar locals; nothing is allocated inside the step loop
 (the work arrays are made once per call); the ``lie`` field never forms ``R = R_n exp(û)``, it
@@ -30,11 +22,12 @@ family inside one loop). The
 from __future__ import annotations
 
 import math
+import types
+from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit, prange
-
-from tumble.ode.solve import fixed_step_count
 
 SERIES_ANGLE = 0.25
 """Below this angle (rad) the exp and dexp⁻¹ coefficients use their Taylor series; the first
@@ -120,8 +113,10 @@ def _quat_matrix(q0, q1, q2, q3, out):
 
 
 @njit(**_JIT)
-def _loads(off, zs, R, a, b, u0, u1, u2, m, F, tau, points, point_forces, K, i):
+def _loads(off, zs, R, a, b, u0, u1, u2, problem, K, i):
     """``K[i, off:] = (p/m, F + Σ f_k, τ + Σ (R exp(û) r_k) × f_k)``, ``zs[off:] = (x, p, L)``."""
+    m, F, tau = problem.m, problem.F, problem.tau
+    points, point_forces = problem.points, problem.point_forces
     for c in range(3):
         K[i, off + c] = zs[off + 3 + c] / m
         K[i, off + 3 + c] = F[c]
@@ -139,22 +134,22 @@ def _loads(off, zs, R, a, b, u0, u1, u2, m, F, tau, points, point_forces, K, i):
         K[i, off + 8] += t2
 
 
-# A family is three functions: field(correct, zs, Rn, R, inv_I, m, F, tau, points,
-# point_forces, K, i) writes K[i] = f(zs); advance(z, znew, Rn) sets z (and Rn) to the new
-# state; record(z, Rn, R_out, q_out, Y_out) writes one sample.
+# A chart's compiled twin is three functions: field(problem, zs, Rn, R, K, i) writes
+# K[i] = f(zs); advance(z, znew, Rn) sets z (and Rn) to the new state; record(z, Rn, R_out,
+# q_out, Y_out) writes one sample. ``problem`` is a :class:`Problem`.
 
 
 @njit(**_INLINE)
-def _lie_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i):
+def _lie_field(problem, zs, Rn, R, K, i):
     """``u̇ = dexp⁻¹_{−u}(ω)`` (``ω`` if not ``correct``), ``ω = I⁻¹ exp(−û) R_nᵀ L``."""
     u0, u1, u2 = zs[0], zs[1], zs[2]
     theta2 = u0 * u0 + u1 * u1 + u2 * u2
     a, b = _exp_coefficients(theta2)
     w0, w1, w2 = _apply_transpose(Rn, zs[9], zs[10], zs[11])
-    w0, w1, w2 = _apply(inv_I, *_rotate(-a, b, u0, u1, u2, w0, w1, w2))
-    half, alpha = (0.5, _dexpinv_coefficient(theta2)) if correct else (0.0, 0.0)
+    w0, w1, w2 = _apply(problem.inv_I, *_rotate(-a, b, u0, u1, u2, w0, w1, w2))
+    half, alpha = (0.5, _dexpinv_coefficient(theta2)) if problem.correct else (0.0, 0.0)
     K[i, 0], K[i, 1], K[i, 2] = _rotate(half, alpha, u0, u1, u2, w0, w1, w2)
-    _loads(3, zs, Rn, a, b, u0, u1, u2, m, F, tau, points, point_forces, K, i)
+    _loads(3, zs, Rn, a, b, u0, u1, u2, problem, K, i)
 
 
 @njit(**_INLINE)
@@ -176,17 +171,17 @@ def _lie_record(z, Rn, R_out, q_out, Y_out):
 
 
 @njit(**_INLINE)
-def _quat_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i):
+def _quat_field(problem, zs, Rn, R, K, i):
     """``q̇ = ½ q ⊗ (0, ω)``, ``ω = I⁻¹ Rᵀ L`` with ``R = R(q/|q|)``."""
     q0, q1, q2, q3 = zs[0], zs[1], zs[2], zs[3]
     norm = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
     _quat_matrix(q0 / norm, q1 / norm, q2 / norm, q3 / norm, R)
-    w0, w1, w2 = _apply(inv_I, *_apply_transpose(R, zs[10], zs[11], zs[12]))
+    w0, w1, w2 = _apply(problem.inv_I, *_apply_transpose(R, zs[10], zs[11], zs[12]))
     K[i, 0] = 0.5 * (-q1 * w0 - q2 * w1 - q3 * w2)
     K[i, 1] = 0.5 * (q0 * w0 + q2 * w2 - q3 * w1)
     K[i, 2] = 0.5 * (q0 * w1 + q3 * w0 - q1 * w2)
     K[i, 3] = 0.5 * (q0 * w2 + q1 * w1 - q2 * w0)
-    _loads(4, zs, R, 0.0, 0.0, 0.0, 0.0, 0.0, m, F, tau, points, point_forces, K, i)
+    _loads(4, zs, R, 0.0, 0.0, 0.0, 0.0, 0.0, problem, K, i)
 
 
 @njit(**_INLINE)
@@ -207,17 +202,17 @@ def _quat_record(z, Rn, R_out, q_out, Y_out):
 
 
 @njit(**_INLINE)
-def _matrix_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i):
+def _matrix_field(problem, zs, Rn, R, K, i):
     """``Ṙ = R ω̂``, ``ω = I⁻¹ Rᵀ L``, R the first nine numbers of ``zs``."""
     for r in range(3):
         for c in range(3):
             R[r, c] = zs[3 * r + c]
-    w0, w1, w2 = _apply(inv_I, *_apply_transpose(R, zs[15], zs[16], zs[17]))
+    w0, w1, w2 = _apply(problem.inv_I, *_apply_transpose(R, zs[15], zs[16], zs[17]))
     for r in range(3):
         K[i, 3 * r + 0] = R[r, 1] * w2 - R[r, 2] * w1
         K[i, 3 * r + 1] = R[r, 2] * w0 - R[r, 0] * w2
         K[i, 3 * r + 2] = R[r, 0] * w1 - R[r, 1] * w0
-    _loads(9, zs, R, 0.0, 0.0, 0.0, 0.0, 0.0, m, F, tau, points, point_forces, K, i)
+    _loads(9, zs, R, 0.0, 0.0, 0.0, 0.0, 0.0, problem, K, i)
 
 
 @njit(**_INLINE)
@@ -234,167 +229,130 @@ def _matrix_record(z, Rn, R_out, q_out, Y_out):
     Y_out[:] = z[9:]
 
 
-def _compile_loop(family: int):
-    """The step loop of one family, compiled with that family's field and map back inlined.
+class Problem(NamedTuple):
+    """What the compiled loops need of a run besides its state: method and loads.
 
-    ``family`` is a constant of the closure, so numba drops the other families' branches and
-    caches one loop per family (the cache is keyed by the closure's value).
+    ``correct``: stages corrected by dexp⁻¹ (False only for ``seed-rk4``); ``A``, ``b``: the
+    tableau; ``inv_I`` (3, 3), ``m``: the body; ``F`` (3,), ``tau`` (3,): constant force on
+    the centre of mass and torque (world); ``points`` (k, 3), ``point_forces`` (k, 3): body
+    points and the constant world forces there. For :func:`run_batch` ``inv_I``, ``m`` and
+    ``F`` carry a leading body axis.
     """
 
-    @njit(**_JIT)
-    def loop(correct, A, b, z, Rn, t_a, h, k0, k1, n, t_b, inv_I, m, F, tau, points,
-             point_forces, every, step0, rec_t, rec_R, rec_q, rec_Y):  # fmt: skip
-        s, nz = b.shape[0], z.shape[0]
-        K, zs, R = np.empty((s, nz)), np.empty(nz), np.empty((3, 3))
-        count, until_record = 0, every - (step0 + k0) % every
-        for k in range(k0 + 1, k1 + 1):
-            t_old = t_a + (k - 1) * h
-            hk = (t_b if k == n else t_a + k * h) - t_old
-            for i in range(s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
-                for q in range(nz):
-                    acc = 0.0
-                    for j in range(i):
-                        acc += A[i, j] * K[j, q]
-                    zs[q] = z[q] + hk * acc
-                if family == 2:
-                    _lie_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i)
-                elif family == 1:
-                    _quat_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i)
-                else:
-                    _matrix_field(correct, zs, Rn, R, inv_I, m, F, tau, points, point_forces, K, i)
-            finite = True
-            for q in range(nz):  # z_new = z + h Σ b_i k_i
-                acc = 0.0
-                for i in range(s):
-                    acc += b[i] * K[i, q]
-                zs[q] = z[q] + hk * acc
-                finite = finite and math.isfinite(zs[q])
-            if not finite:
-                return count, k
-            if family == 2:
-                _lie_advance(z, zs, Rn)
-            elif family == 1:
-                _quat_advance(z, zs, Rn)
-            else:
-                _matrix_advance(z, zs, Rn)
-            until_record -= 1
-            if until_record == 0:
-                rec_t[count] = t_old + hk
-                if family == 2:
-                    _lie_record(z, Rn, rec_R[count], rec_q[count], rec_Y[count])
-                elif family == 1:
-                    _quat_record(z, Rn, rec_R[count], rec_q[count], rec_Y[count])
-                else:
-                    _matrix_record(z, Rn, rec_R[count], rec_q[count], rec_Y[count])
-                count += 1
-                until_record = every
-        return count, -1
-
-    return loop
+    correct: bool
+    A: np.ndarray
+    b: np.ndarray
+    inv_I: np.ndarray
+    m: float
+    F: np.ndarray
+    tau: np.ndarray
+    points: np.ndarray
+    point_forces: np.ndarray
 
 
-FAMILY_CODES = {"matrix": 0, "quat": 1, "lie": 2}
-ATTITUDE_SIZE = {"matrix": 9, "quat": 4, "lie": 3}
-_MATRIX_LOOP, _QUAT_LOOP, _LIE_LOOP = (_compile_loop(code) for code in range(3))
-LOOPS = {"matrix": _MATRIX_LOOP, "quat": _QUAT_LOOP, "lie": _LIE_LOOP}
+class Records(NamedTuple):
+    """Where a loop writes its samples: ``t`` (m,), ``R`` (m, 3, 3), ``q`` (m, 4), ``Y`` (m, 9)
+    (with a leading body axis for :func:`run_batch`)."""
+
+    t: np.ndarray
+    R: np.ndarray
+    q: np.ndarray
+    Y: np.ndarray
 
 
-def run_fixed(family: str, *args):
-    """Steps ``k0+1 … k1`` of the grid ``t_a + k h`` (step ``n`` lands on ``t_b``).
+def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
+    """Steps ``k0+1 … k1`` of ``grid`` (a :class:`~tumble.ode.driver.Grid`) for one chart.
 
-    ``args = (correct, A, b, z, Rn, t_a, h, k0, k1, n, t_b, inv_I, m, F, tau, points,
-    point_forces, every, step0, rec_t, rec_R, rec_q, rec_Y)``. Each step is one explicit
-    Runge–Kutta step of the family's chart (as :func:`tumble.ode.stepper.rk_step`)
+    Each step is one explicit Runge–Kutta step of the chart's field (as
+    :func:`tumble.ode.stepper.rk_step`)
 
     .. math:: k_i = f\\Bigl(z + h \\sum_{j<i} a_{ij} k_j\\Bigr), \\quad
               z_{n+1} = z + h \\sum_i b_i k_i,
 
-    then the family's map back. ``z`` (and ``Rn`` for the lie family) hold the state and are
-    updated in place. A step is recorded in ``rec_*`` when ``step0 + k`` is a multiple of
-    ``every``. Returns ``(recorded, failed)`` with ``failed`` the step whose result was not
-    finite, or -1.
+    then the chart's map back. ``z`` (and ``Rn``) hold the state and are updated in place.
+    Step ``k`` is recorded when ``step0 + k`` is a multiple of ``every``. Returns
+    ``(recorded, failed)``: ``failed`` is the step whose result was not finite (the state is
+    left at the step before), or -1. ``FIELD``, ``ADVANCE`` and ``RECORD`` are the chart's
+    compiled functions, bound by :func:`_for_chart`.
     """
-    return LOOPS[family](*args)
+    A, b = problem.A, problem.b
+    t_a, t_b, h, n = grid
+    s, nz = b.shape[0], z.shape[0]
+    K, zs, R = np.empty((s, nz)), np.empty(nz), np.empty((3, 3))
+    count, until_record = 0, every - (step0 + k0) % every
+    for k in range(k0 + 1, k1 + 1):
+        t_old = t_a + (k - 1) * h
+        hk = (t_b if k == n else t_a + k * h) - t_old
+        for i in range(s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
+            for q in range(nz):
+                acc = 0.0
+                for j in range(i):
+                    acc += A[i, j] * K[j, q]
+                zs[q] = z[q] + hk * acc
+            FIELD(problem, zs, Rn, R, K, i)  # noqa: F821
+        finite = True
+        for q in range(nz):  # z_new = z + h Σ b_i k_i
+            acc = 0.0
+            for i in range(s):
+                acc += b[i] * K[i, q]
+            zs[q] = z[q] + hk * acc
+            finite = finite and math.isfinite(zs[q])
+        if not finite:
+            return count, k
+        ADVANCE(z, zs, Rn)  # noqa: F821
+        until_record -= 1
+        if until_record == 0:
+            records.t[count] = t_old + hk
+            RECORD(z, Rn, records.R[count], records.q[count], records.Y[count])  # noqa: F821
+            count += 1
+            until_record = every
+    return count, -1
 
 
-@njit(**_JIT)
-def _run_body(family, correct, A, b, z, Rn, t_a, h, n, t_b, inv_I, m, F, tau, points,
-              point_forces, every, rec_t, rec_R, rec_q, rec_Y):  # fmt: skip
-    """All ``n`` steps of one body with the loop of ``family`` (a code of FAMILY_CODES)."""
-    args = (correct, A, b, z, Rn, t_a, h, 0, n, n, t_b, inv_I, m, F, tau, points,
-            point_forces, every, 0, rec_t, rec_R, rec_q, rec_Y)  # fmt: skip
-    if family == 2:
-        return _LIE_LOOP(*args)
-    if family == 1:
-        return _QUAT_LOOP(*args)
-    return _MATRIX_LOOP(*args)
+def _batch(problem, grid, Z, RN, every, records, counts, failed):
+    """:data:`LOOP` over all the steps of ``grid`` for every body ``k`` in parallel.
 
-
-@njit(cache=True, error_model="numpy", parallel=True)
-def run_batch(family, correct, A, b, Z, RN, t_a, h, n, t_b, inv_I, m, F, tau, points,
-              point_forces, every, rec_t, rec_R, rec_q, rec_Y, counts, failed):  # fmt: skip
-    """:func:`run_fixed` over steps ``1 … n`` for every body ``k`` in parallel (``prange``).
-
-    ``family`` is a code of :data:`FAMILY_CODES`. Body ``k``'s state is ``Z[k]`` (and
-    ``RN[k]``), its inverse inertia ``inv_I[k]``, mass ``m[k]`` and centre-of-mass force
-    ``F[k]``; ``tau``, ``points`` and ``point_forces`` are shared. Its samples go to
-    ``rec_t[k]``, ``rec_R[k]``, …; ``counts[k]`` samples and the failed step ``failed[k]``
-    (-1 if none) come back.
+    Body ``k``'s state is ``Z[k]`` (and ``RN[k]``), its data ``problem.inv_I[k]``,
+    ``problem.m[k]`` and ``problem.F[k]``; its samples go to ``records.t[k]``, … ;
+    ``counts[k]`` samples and the failed step ``failed[k]`` (-1 if none) come back.
     """
     for k in prange(Z.shape[0]):
-        counts[k], failed[k] = _run_body(
-            family, correct, A, b, Z[k], RN[k], t_a, h, n, t_b, inv_I[k], m[k], F[k], tau,
-            points, point_forces, every, rec_t[k], rec_R[k], rec_q[k], rec_Y[k],
-        )  # fmt: skip
+        p = problem
+        body = Problem(p.correct, p.A, p.b, p.inv_I[k], p.m[k], p.F[k], p.tau, p.points,
+                       p.point_forces)  # fmt: skip
+        body_records = Records(records.t[k], records.R[k], records.q[k], records.Y[k])
+        counts[k], failed[k] = LOOP(body, grid, Z[k], RN[k], 0, grid.n, every, 0, body_records)  # noqa: F821
 
 
-def pack(family: str, attitude: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The kernel's ``(z, Rn)`` for a family's attitude (R or q) and ``Y = (x, p, L)``."""
-    if family == "lie":
-        return np.concatenate([np.zeros(3), Y]), np.array(attitude, dtype=float)
-    return np.concatenate([np.ravel(attitude), Y]), np.eye(3)
+def _bind(template, name: str, **functions):
+    """``template`` compiled with ``functions`` as its globals, cached under its own name.
+
+    numba's on-disk cache is keyed by a function's qualified name and code, so each chart's
+    loop gets a name of its own; a closure over compiled functions would miss the cache.
+    """
+    bound = types.FunctionType(template.__code__, {**globals(), **functions}, name)
+    bound.__qualname__ = name
+    bound.__doc__ = template.__doc__
+    return bound
 
 
-def unpack(family: str, z: np.ndarray, Rn: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Inverse of :func:`pack`."""
-    if family == "lie":
-        return Rn.copy(), z[3:].copy()
-    size = ATTITUDE_SIZE[family]
-    attitude = z[:size].reshape(3, 3) if family == "matrix" else z[:size]
-    return attitude.copy(), z[size:].copy()
+@dataclass(frozen=True)
+class CompiledChart:
+    """A chart's compiled loop for one body and for a batch."""
+
+    loop: object
+    batch: object
 
 
-def _chunks(n: int, progress: bool) -> list[tuple[int, int]]:
-    size = max(1, n // 50) if progress else n
-    return [(k0, min(k0 + size, n)) for k0 in range(0, n, size)]
+def _for_chart(name: str, field, advance, record) -> CompiledChart:
+    loop = njit(**_JIT)(_bind(_loop, f"_loop_{name}", FIELD=field, ADVANCE=advance, RECORD=record))
+    batch = njit(parallel=True, **_JIT)(_bind(_batch, f"_batch_{name}", LOOP=loop))
+    return CompiledChart(loop, batch)
 
 
-def run_segment(run, b: float, h: float, loads, advance) -> bool:
-    """Integrate ``run`` from ``run.t`` to ``b`` with the kernel; False if it stopped."""
-    F, tau, points, point_forces = loads
-    family, method = run.method.family, run.method
-    A, weights = method.tableau.A, method.tableau.b
-    inv_I, every, a = run.dynamics.inertia_inverse, run.record_every, run.t
-    n = fixed_step_count(a, b, h)
-    z, Rn = pack(family, run.attitude, run.Y)
-    for k0, k1 in _chunks(n, advance is not None):
-        size = (k1 - k0) // every + 1
-        rec_t, rec_R = np.empty(size), np.empty((size, 3, 3))
-        rec_q, rec_Y = np.empty((size, 4)), np.empty((size, 9))
-        count, failed = run_fixed(family, method.dexpinv, A, weights, z, Rn, a, h,
-                                  k0, k1, n, b, inv_I, run.dynamics.mass, F, tau, points,
-                                  point_forces, every, run.n_steps - k0, rec_t, rec_R, rec_q,
-                                  rec_Y)  # fmt: skip
-        q_block = rec_q[:count] if family == "quat" else None
-        run.extend(rec_t[:count], rec_R[:count], rec_Y[:count], q_block)
-        attitude, Y = unpack(family, z, Rn)
-        done = k1 if failed < 0 else failed - 1
-        t_done = b if done == n else a + done * h
-        run.n_steps += done - k0
-        run.t, run.attitude, run.Y = t_done, attitude, Y
-        if failed >= 0:
-            run.fail_non_finite(t_done, b if failed == n else a + failed * h)
-            return False
-        if advance is not None:
-            advance(run.t)
-    return True
+COMPILED: dict[str, CompiledChart] = {
+    "matrix": _for_chart("matrix", _matrix_field, _matrix_advance, _matrix_record),
+    "quat": _for_chart("quat", _quat_field, _quat_advance, _quat_record),
+    "lie": _for_chart("lie", _lie_field, _lie_advance, _lie_record),
+}
+"""Each chart of :data:`tumble.rigid.charts.CHARTS`, compiled."""

@@ -1,116 +1,118 @@
-"""The readable NumPy reference of every rigid-body method: one RK step in a local chart.
+"""The rigid-body stepper of the driver: a method's chart and tableau, in Python or compiled.
 
-Each family turns the rigid body into an ODE on a vector ``z`` for the duration of one step
-and hands it to the ODE core's :func:`~tumble.ode.stepper.rk_step`, so every method is the
-same mechanism with other data:
+:class:`RigidStepper` is the readable NumPy reference: one :func:`~tumble.ode.stepper.rk_step`
+of the method's tableau in the method's chart (:mod:`tumble.rigid.charts`).
+:class:`CompiledStepper` marches whole blocks of a fixed grid in the chart's numba loop
+(:mod:`tumble.rigid.kernels`), the same algorithm; ``tests/rigid`` checks they agree to
+round-off. Both plug into :func:`tumble.ode.driver.march`, which owns the time loop.
 
-* ``matrix``: ``z = (vec R, x, p, L)`` with ``Ṙ = R ω̃_body``;
-* ``quat``: ``z = (q, x, p, L)`` with ``q̇ = ½ q ⊗ (0, ω_body)``, then ``q ← q/|q|``;
-* ``lie`` (Runge–Kutta–Munthe-Kaas, Munthe-Kaas 1998): ``R = R_n exp(û)``,
-  ``z = (u, x, p, L)`` with ``u(0) = 0`` and the right-trivialised equation
-
-  .. math:: \\dot u = \\operatorname{dexp}^{-1}_{-u}(\\omega_{body}),
-
-  so ``R_{n+1} = R_n exp(û_{n+1})`` lies on SO(3) to round-off.
-
-Everywhere ``ω_body = I⁻¹ Rᵀ L``, ``ẋ = p/m``, ``ṗ = F`` and ``L̇ = τ`` (world frame).
-The compiled kernels in :mod:`tumble.rigid.kernels` run the same algorithm.
+The stepped state is ``(attitude, Y)``: the chart's attitude (R, or q for the ``quat`` chart)
+and ``Y = (x, p, L)``, shape (9,).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
-from tumble import so3
+from tumble.ode.driver import Block, Grid, Stepper
 from tumble.ode.stepper import rk_step
-from tumble.rigid.body import RigidBody
-from tumble.rigid.forces import State, total_load
+from tumble.rigid.charts import CHARTS, Dynamics
+from tumble.rigid.forces import State
 from tumble.rigid.methods import Method
 
-
-class Dynamics:
-    """The right-hand side of a body under its continuous loads."""
-
-    def __init__(self, body: RigidBody, loads):
-        self.body, self.loads = body, list(loads)
-        self.mass, self.inertia_inverse = body.mass, body.inertia_inverse
-
-    def rates(self, t: float, R: np.ndarray, Y: np.ndarray) -> np.ndarray:
-        """``(ẋ, ṗ, L̇) = (p/m, F, τ)`` for ``Y = (x, p, L)``, shape (9,)."""
-        x, p, L = Y[:3], Y[3:6], Y[6:]
-        F, tau = total_load(self.loads, t, State(x, R, p, L), self.mass)
-        return np.concatenate([p / self.mass, F, tau])
-
-    def omega(self, R: np.ndarray, L: np.ndarray) -> np.ndarray:
-        """``ω_body = I⁻¹ Rᵀ L``."""
-        return self.inertia_inverse @ (R.T @ L)
+RigidState = tuple[np.ndarray, np.ndarray]
+"""``(attitude, Y)``: the chart's attitude and ``(x, p, L)``."""
 
 
-def _matrix_step(dynamics: Dynamics, method: Method, t, R, Y, h):
-    def f(t, z):
-        R = z[:9].reshape(3, 3)
-        Rdot = R @ so3.hat(dynamics.omega(R, z[15:]))
-        return np.concatenate([Rdot.ravel(), dynamics.rates(t, R, z[9:])])
+class RigidStepper(Stepper):
+    """One step of ``method`` on ``dynamics``: its tableau in its chart (NumPy)."""
 
-    z = np.concatenate([R.ravel(), Y])
-    K = np.empty((method.tableau.stages, z.size))
-    z_new, error = rk_step(f, t, z, f(t, z), h, method.tableau, K)
-    return z_new[:9].reshape(3, 3), z_new[9:], error
+    def __init__(self, method: Method, dynamics: Dynamics):
+        self.method, self.dynamics = method, dynamics
+        self.chart = CHARTS[method.family]
+        self.adaptive = method.adaptive
+        self.error_order = method.tableau.error_order
+        self._chart_scale = np.ones(self.chart.size)  # chart errors measured against 1
+        self._quat = self.chart.name == "quat"
+
+    def start(self, R: np.ndarray, Y: np.ndarray) -> RigidState:
+        """The stepped state for the attitude ``R`` and ``Y = (x, p, L)``."""
+        return self.chart.attitude(R), Y
+
+    def step(self, t: float, state: RigidState, h: float) -> tuple[RigidState, np.ndarray | None]:
+        chart, tableau = self.chart, self.method.tableau
+        z, Rn = chart.pack(*state)
+        f = chart.field(self.dynamics, self.method.dexpinv, Rn)
+        K = np.empty((tableau.stages, z.size))
+        z_new, error = rk_step(f, t, z, f(t, z), h, tableau, K)
+        return chart.advance(z_new, Rn), error
+
+    def scale(self, state: RigidState) -> np.ndarray:
+        return np.concatenate([self._chart_scale, np.abs(state[1])])
+
+    def record(self, state: RigidState) -> tuple:
+        attitude, Y = state
+        q = attitude[None] if self._quat else np.empty((1, 0))
+        return np.array(self.chart.matrix(attitude))[None], Y[None], q
+
+    def public(self, state: RigidState) -> State:
+        """The state as users' loads and events see it: ``State(x, R, p, L)``."""
+        attitude, Y = state
+        return State(Y[:3], self.chart.matrix(attitude), Y[3:6], Y[6:])
+
+    def event(self, event: Callable) -> Callable:
+        """A user's ``g(t, State)`` as the driver's ``g(t, state)``."""
+
+        def g(t: float, state: RigidState) -> float:
+            return event(t, self.public(state))
+
+        g.terminal = getattr(event, "terminal", False)  # type: ignore[attr-defined]
+        g.direction = getattr(event, "direction", 0)  # type: ignore[attr-defined]
+        return g
+
+    def kick(self, impulses) -> Callable[[RigidState], RigidState]:
+        """The jump of ``impulses`` at one time: ``Δp = J``, ``ΔL = (point − x) × J``."""
+
+        def apply(state: RigidState) -> RigidState:
+            attitude, Y = state
+            for impulse in impulses:
+                dp, dL = impulse.kick(Y[:3])
+                Y = Y + np.concatenate([np.zeros(3), dp, dL])
+            return attitude, Y
+
+        return apply
 
 
-def _quat_step(dynamics: Dynamics, method: Method, t, q, Y, h):
-    def f(t, z):
-        R = so3.matrix_from_quat(z[:4] / np.linalg.norm(z[:4]))
-        omega = dynamics.omega(R, z[10:])
-        qdot = 0.5 * so3.quat_mul(z[:4], np.concatenate([[0.0], omega]))
-        return np.concatenate([qdot, dynamics.rates(t, R, z[4:])])
+class CompiledStepper(RigidStepper):
+    """:class:`RigidStepper` whose fixed grids march in the chart's compiled loop.
 
-    z = np.concatenate([q, Y])
-    K = np.empty((method.tableau.stages, z.size))
-    z_new, error = rk_step(f, t, z, f(t, z), h, method.tableau, K)
-    return z_new[:4] / np.linalg.norm(z_new[:4]), z_new[4:], error
-
-
-def _lie_step(dynamics: Dynamics, method: Method, t, R_n, Y, h):
-    def f(t, z):
-        u = z[:3]
-        R = R_n @ so3.exp(u)
-        omega = dynamics.omega(R, z[9:])
-        udot = so3.dexpinv_apply(-u, omega) if method.dexpinv else omega
-        return np.concatenate([udot, dynamics.rates(t, R, z[3:])])
-
-    z = np.concatenate([np.zeros(3), Y])
-    K = np.empty((method.tableau.stages, z.size))
-    z_new, error = rk_step(f, t, z, f(t, z), h, method.tableau, K)
-    return R_n @ so3.exp(z_new[:3]), z_new[3:], error
-
-
-_FAMILIES = {"matrix": _matrix_step, "quat": _quat_step, "lie": _lie_step}
-
-
-def step(dynamics: Dynamics, method: Method, t: float, attitude, Y: np.ndarray, h: float):
-    """One step of ``method`` from ``(attitude, Y)`` at ``t``.
-
-    Parameters
-    ----------
-    dynamics : Dynamics
-        The body and its loads.
-    method : Method
-        Which family and tableau.
-    t : float
-        Time (s).
-    attitude : ndarray, shape (3, 3) or (4,)
-        R for the ``matrix`` and ``lie`` families, the unit quaternion for ``quat``.
-    Y : ndarray, shape (9,)
-        ``(x, p, L)``.
-    h : float
-        Step (s).
-
-    Returns
-    -------
-    attitude_new, Y_new : ndarray
-        The state at ``t + h``.
-    error : ndarray or None
-        The embedded error estimate in the chart's coordinates (adaptive tableaux only).
+    ``problem`` is the kernels' :class:`~tumble.rigid.kernels.Problem` (constant loads).
     """
-    return _FAMILIES[method.family](dynamics, method, t, attitude, Y, h)
+
+    blocks = True
+
+    def __init__(self, method: Method, dynamics: Dynamics, problem):
+        from tumble.rigid.kernels import COMPILED
+
+        super().__init__(method, dynamics)
+        self.problem, self.loop = problem, COMPILED[self.chart.name].loop
+
+    def march_block(
+        self, state: RigidState, grid: Grid, k0: int, k1: int, every: int, step0: int
+    ) -> Block:
+        from tumble.rigid.kernels import Records
+
+        size = (k1 - k0) // every + 1
+        records = Records(np.empty(size), np.empty((size, 3, 3)), np.empty((size, 4)),
+                          np.empty((size, 9)))  # fmt: skip
+        z, Rn = self.chart.pack(*state)
+        count, failed = self.loop(self.problem, grid, z, Rn, k0, k1, every, step0, records)
+        q = records.q[:count] if self._quat else np.empty((count, 0))
+        return Block(
+            t=records.t[:count],
+            records=(records.R[:count], records.Y[:count], q),
+            state=self.chart.read(z, Rn),
+            failed=failed,
+        )

@@ -8,6 +8,7 @@ from functools import cached_property
 import numpy as np
 
 from tumble import so3
+from tumble.ode.driver import Status
 from tumble.rigid.body import RigidBody
 
 
@@ -31,8 +32,9 @@ class Trajectory:
         The method's name.
     settings : dict
         ``h`` or ``rtol``/``atol``, ``record_every``, the compiled-kernel flag.
-    status : int
-        0: reached ``t_end``; 1: a terminal event; -1: stopped by a non-finite state.
+    status : Status
+        ``SUCCESS`` (0): reached ``t_end``; ``TERMINAL_EVENT`` (1); ``FAILED`` (-1): stopped
+        by a non-finite state (see :class:`~tumble.ode.driver.Status`).
     message : str
         What happened, naming ``t`` on failure.
     n_steps, n_rejected : int
@@ -51,8 +53,8 @@ class Trajectory:
     body: RigidBody
     method: str
     settings: dict = field(default_factory=dict)
-    status: int = 0
-    message: str = "The simulation reached t_end."
+    status: Status = Status.SUCCESS
+    message: str = Status.SUCCESS.message
     n_steps: int = 0
     n_rejected: int = 0
     t_events: list = field(default_factory=list)

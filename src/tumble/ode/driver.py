@@ -1,0 +1,493 @@
+"""The one stepping driver: :func:`march` takes any stepper over a span.
+
+Every time loop in tumble is this one: ``solve`` (a Runge–Kutta tableau on a vector),
+``simulate`` (a rigid-body chart, in Python or in compiled blocks), ``simulate_batch`` (many
+bodies in one compiled block) and the structural schemes (one factorised solve a step). What
+differs is the *stepper*; what the run does around the steps is written once, here.
+
+The stepper's contract
+----------------------
+A stepper is an object with (see :class:`Stepper`, which gives the defaults):
+
+``adaptive`` : bool
+    Whether ``step`` returns an error estimate for the step controller.
+``error_order`` : int
+    Order ``q`` of that estimate (the controller's exponent is ``1/(q + 1)``).
+``step(t, state, h) -> (new_state, error)``
+    One step from ``state`` at ``t``. ``error`` is the local error estimate (an array in the
+    units of :meth:`~Stepper.scale`) or None. It must not change ``state`` unless it is
+    never needed again (no events, no retries: :attr:`~Stepper.in_place`).
+``accept(t, state)``
+    Told that a step to ``(t, state)`` was accepted (first-same-as-last data, counters).
+``interpolant(t_old, old, t_new, new) -> sol``
+    ``sol(t)`` for ``t`` in ``[t_old, t_new]``: the state between the two (the dense output
+    that events are located on). Called only after ``accept``.
+``finite(state) -> bool``, ``scale(state) -> ndarray``
+    Whether every number of a state is finite; the magnitudes the error is relative to.
+``record(state) -> tuple of ndarray``
+    One sample: each array with a time axis of length 1 at :attr:`~Stepper.time_axis`.
+``march_block(state, grid, k0, k1, every, step0) -> Block`` (optional, ``blocks = True``)
+    Steps ``k0 + 1 … k1`` of a fixed grid at once, compiled, recording every ``every``-th
+    step: how the kernels keep their speed with no Python per step.
+
+What :func:`march` guarantees
+-----------------------------
+* Steps land exactly on ``t1`` and on every jump time (a fixed grid restarts at each).
+* ``h`` is the step of a fixed-step run; for an adaptive run (``control`` given) the first
+  step, then the :class:`~tumble.ode.control.StepController` proposes each next one from the
+  weighted norm (:func:`~tumble.ode.control.error_norm`); a rejected step is retried from the
+  accepted state. A step below :func:`~tumble.ode.control.minimum_step` ends the run.
+* The record holds the initial state, every ``record_every``-th accepted step (counted over
+  the whole run) and the final state; after a jump the state at the jump's time replaces the
+  sample taken just before it.
+* A non-finite state ends the run with :attr:`Status.FAILED` and a message naming the step;
+  the record and the final state are the last finite ones.
+* ``max_steps`` accepted steps end the run with :attr:`Status.FAILED`.
+* Events ``g(t, state)`` are located by :class:`~tumble.ode.events.EventTracker` on the
+  stepper's interpolant; a terminal event ends the run there with
+  :attr:`Status.TERMINAL_EVENT`.
+* ``progress(t)`` is called as the run goes (per block, per jump segment, every
+  :data:`PROGRESS_EVERY` Python steps).
+
+References
+----------
+.. [1] E. Hairer, S. P. Nørsett, G. Wanner, *Solving Ordinary Differential Equations I*,
+   2nd ed., Springer, 1993, §II.4 (step control), §II.6 (dense output).
+.. [2] scipy's ``OdeSolver`` (a written contract for steppers) and diffrax's ``RESULTS``
+   (a status type whose values carry their messages).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from enum import IntEnum
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from tumble.ode.control import (
+    StepController,
+    error_norm,
+    fixed_step_count,
+    grid_time,
+    minimum_step,
+)
+from tumble.ode.events import Event, EventTracker
+
+PROGRESS_EVERY = 256
+"""A Python-stepped run reports its progress every this many steps."""
+
+PROGRESS_BLOCKS = 50
+"""A compiled run with a progress bar marches in about this many blocks."""
+
+
+class Status(IntEnum):
+    """How a run ended; the codes of ``scipy.integrate.solve_ivp``.
+
+    Every result type (:class:`~tumble.ode.OdeResult`, :class:`~tumble.Trajectory`,
+    :class:`~tumble.BatchTrajectory`, :class:`~tumble.structural.Response`) carries one,
+    with a ``message`` that says the time. Compare with the members or the integers.
+
+    Examples
+    --------
+    >>> Status.FAILED == -1, Status.TERMINAL_EVENT.success, Status.SUCCESS.message
+    (True, True, 'The run reached the end of the interval.')
+    """
+
+    SUCCESS = 0
+    TERMINAL_EVENT = 1
+    FAILED = -1
+
+    @property
+    def success(self) -> bool:
+        """True unless the run failed."""
+        return self >= 0
+
+    @property
+    def message(self) -> str:
+        """The generic message (a failure's own message names its cause and time)."""
+        return _MESSAGES[self]
+
+
+_MESSAGES = {
+    Status.SUCCESS: "The run reached the end of the interval.",
+    Status.TERMINAL_EVENT: "A terminal event occurred.",
+    Status.FAILED: "The run failed.",
+}
+
+
+def non_finite_message(t_old: float, t_new: float) -> str:
+    """The message of a run stopped by a non-finite state (the one wording everywhere)."""
+    return (
+        f"the state became non-finite (nan or inf) in the step from t={t_old!r} to "
+        f"t={t_new!r}; the run ends with the last finite state"
+    )
+
+
+class Grid(NamedTuple):
+    """A fixed-step grid: ``n`` steps from ``t0``, step ``k`` ending at ``t0 + k h`` and the
+    last exactly at ``t1``."""
+
+    t0: float
+    t1: float
+    h: float
+    n: int
+
+    def time(self, k: int) -> float:
+        """Where step ``k`` ends."""
+        return grid_time(self.t0, self.t1, self.h, k, self.n)
+
+
+@dataclass
+class Block:
+    """What a compiled block of steps returns.
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Times of the samples it recorded.
+    records : tuple of ndarray
+        The samples, as :meth:`Stepper.record` lays them out, ``m`` along the time axis.
+    state : object
+        The state after the block (the last finite one if it stopped).
+    failed : int
+        The grid step whose result was not finite (the block stopped before it), or -1.
+    """
+
+    t: np.ndarray
+    records: tuple
+    state: Any
+    failed: int = -1
+
+
+class Stepper:
+    """Defaults of the stepper contract (module docstring); subclasses override ``step``."""
+
+    adaptive: bool = False
+    error_order: int = 1
+    blocks: bool = False
+    """Whether :meth:`march_block` runs a fixed grid compiled."""
+    in_place: bool = False
+    """Whether ``step`` overwrites its ``state`` (then no events, no adaptive control)."""
+    time_axis: int = 0
+    """The axis of :meth:`record`'s arrays along which samples are stacked."""
+
+    def step(self, t: float, state: Any, h: float) -> tuple[Any, np.ndarray | None]:
+        raise NotImplementedError
+
+    def accept(self, t: float, state: Any) -> None:
+        """A step to ``(t, state)`` was accepted."""
+
+    def interpolant(self, t_old: float, old: Any, t_new: float, new: Any) -> Callable:
+        """The state between two accepted ones; by default a step from ``old`` to ``t``."""
+
+        def sol(t: float) -> Any:
+            return old if t == t_old else self.step(t_old, old, t - t_old)[0]
+
+        return sol
+
+    def finite(self, state: Any) -> bool:
+        parts = state if isinstance(state, tuple) else (state,)
+        return all(bool(np.all(np.isfinite(part))) for part in parts)
+
+    def scale(self, state: Any) -> np.ndarray:
+        return np.abs(state)
+
+    def record(self, state: Any) -> tuple:
+        return (np.asarray(state)[None],)
+
+    def march_block(
+        self, state: Any, grid: Grid, k0: int, k1: int, every: int, step0: int
+    ) -> Block:
+        raise NotImplementedError
+
+
+@dataclass(frozen=True)
+class Control:
+    """Adaptive step control: tolerances and the controller (diffrax's split: the stepper
+    never picks a step, the controller never sees a tableau)."""
+
+    rtol: float
+    atol: np.ndarray | float
+    controller: StepController = field(default_factory=StepController)
+
+
+Jump = tuple[float, Callable[[Any], Any]]
+"""``(time, apply)``: at ``time`` the state becomes ``apply(state)`` (an impulse)."""
+
+
+@dataclass
+class Outcome:
+    """What :func:`march` returns; the callers turn it into their result types.
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Times of the recorded samples.
+    records : tuple of ndarray
+        The samples, stacked along the stepper's time axis.
+    state : object
+        The final state, at ``t[-1]``.
+    status, message : Status, str
+        How the run ended.
+    n_steps, n_rejected : int
+        Accepted and rejected steps.
+    t_events, y_events : list
+        Per event, the times and states where it fired.
+    step_times, interpolants : list or None
+        Every accepted step's end and its interpolant, with ``dense_output=True``.
+    """
+
+    t: np.ndarray
+    records: tuple
+    state: Any
+    status: Status
+    message: str
+    n_steps: int
+    n_rejected: int
+    t_events: list[list[float]]
+    y_events: list[list[Any]]
+    step_times: list[float] | None
+    interpolants: list[Callable] | None
+
+
+class _Run:
+    """One run's current state, counters, record and events."""
+
+    def __init__(self, stepper, t0, state, events, record_every, max_steps, dense, progress):
+        self.stepper, self.t, self.state = stepper, t0, state
+        self.every, self.max_steps, self.progress = record_every, max_steps, progress
+        self.n_steps = self.n_rejected = 0
+        self.status, self.message = Status.SUCCESS, Status.SUCCESS.message
+        self.tracker = EventTracker(events, t0, state) if events else None
+        self.step_times = [t0] if dense else None
+        self.interpolants: list[Callable] | None = [] if dense else None
+        self.times: list[np.ndarray] = []
+        self.samples: list[tuple] = []
+        self.record()
+
+    def fail(self, message: str) -> None:
+        self.status, self.message = Status.FAILED, message
+
+    def record(self) -> None:
+        """Sample the current state (replacing a sample at the same time: before a jump)."""
+        if self.times and self.times[-1][-1] == self.t:
+            axis = self.stepper.time_axis
+            self.times[-1] = self.times[-1][:-1]
+            self.samples[-1] = tuple(np.delete(a, -1, axis=axis) for a in self.samples[-1])
+        self.times.append(np.array([self.t]))
+        self.samples.append(self.stepper.record(self.state))
+
+    def extend(self, block: Block) -> None:
+        if len(block.t):
+            self.times.append(block.t)
+            self.samples.append(block.records)
+
+    def accept(self, t_old: float, old: Any, t_new: float, new: Any) -> bool:
+        """Take an accepted step; True when the run must stop (a terminal event)."""
+        stepper = self.stepper
+        stepper.accept(t_new, new)
+        sol = None
+        if self.tracker is not None or self.interpolants is not None:
+            sol = stepper.interpolant(t_old, old, t_new, new)
+        if self.tracker is not None:
+            t_stop = self.tracker.update(t_old, t_new, new, sol)
+            if t_stop is not None:
+                t_new, new = t_stop, sol(t_stop)
+                self.status, self.message = Status.TERMINAL_EVENT, Status.TERMINAL_EVENT.message
+        if self.interpolants is not None:
+            self.interpolants.append(sol)
+            self.step_times.append(t_new)
+        self.t, self.state = t_new, new
+        self.n_steps += 1
+        if self.n_steps % self.every == 0:
+            self.record()
+        if self.progress is not None and self.n_steps % PROGRESS_EVERY == 0:
+            self.progress(t_new)
+        return self.status == Status.TERMINAL_EVENT
+
+    def outcome(self) -> Outcome:
+        if self.times[-1][-1] != self.t:
+            self.record()
+        axis = self.stepper.time_axis
+        records = tuple(
+            np.concatenate(parts, axis=axis) for parts in zip(*self.samples, strict=True)
+        )
+        tracker = self.tracker
+        return Outcome(
+            t=np.concatenate(self.times),
+            records=records,
+            state=self.state,
+            status=self.status,
+            message=self.message,
+            n_steps=self.n_steps,
+            n_rejected=self.n_rejected,
+            t_events=tracker.t_events if tracker else [],
+            y_events=tracker.y_events if tracker else [],
+            step_times=self.step_times,
+            interpolants=self.interpolants,
+        )
+
+
+def _fixed(run: _Run, t1: float, h: float) -> bool:
+    """Step in Python over the grid from ``run.t`` to ``t1``; False when the run ended."""
+    stepper, grid = run.stepper, Grid(run.t, t1, h, fixed_step_count(run.t, t1, h))
+    for k in range(1, grid.n + 1):
+        if run.n_steps >= run.max_steps:
+            run.fail(f"max_steps={run.max_steps} reached at t={run.t!r}; increase `max_steps`")
+            return False
+        t_old, old, t_new = run.t, run.state, grid.time(k)
+        new, _ = stepper.step(t_old, old, t_new - t_old)
+        if not stepper.finite(new):
+            run.fail(non_finite_message(t_old, t_new))
+            return False
+        if run.accept(t_old, old, t_new, new):
+            return False
+    return True
+
+
+def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, float]:
+    """Step with the controller from ``run.t`` to ``t1``; (going on, the next step)."""
+    stepper, order = run.stepper, run.stepper.error_order
+    rejected = False
+    while run.t < t1:
+        if run.n_steps >= run.max_steps:
+            run.fail(f"max_steps={run.max_steps} reached at t={run.t!r}; increase `max_steps`")
+            return False, h
+        t_old, old = run.t, run.state
+        h_min = minimum_step(t_old)
+        t_new = min(t_old + max(h, h_min), t1)
+        new, error = stepper.step(t_old, old, t_new - t_old)
+        scale_old, scale_new = stepper.scale(old), stepper.scale(new)
+        norm = error_norm(error, scale_old, scale_new, control.rtol, control.atol)
+        accepted, h = control.controller.propose(
+            t_new - t_old, norm, order, after_rejection=rejected
+        )
+        rejected = not accepted
+        if not accepted:
+            run.n_rejected += 1
+            if h < h_min:
+                cause = (
+                    "" if math.isfinite(norm) else " (the solution became non-finite: nan or inf)"
+                )
+                run.fail(f"step size fell below the minimum {h_min:.3g} at t={t_old!r}{cause}")
+                return False, h
+            continue
+        if not stepper.finite(new):
+            run.fail(non_finite_message(t_old, t_new))
+            return False, h
+        if run.accept(t_old, old, t_new, new):
+            return False, h
+    return True, h
+
+
+def _blocks(run: _Run, t1: float, h: float) -> bool:
+    """March the grid from ``run.t`` to ``t1`` in compiled blocks; False when it ended."""
+    grid = Grid(run.t, t1, h, fixed_step_count(run.t, t1, h))
+    last = min(grid.n, run.max_steps - run.n_steps)
+    size = max(1, grid.n // PROGRESS_BLOCKS) if run.progress is not None else grid.n
+    for k0 in range(0, last, size):
+        k1 = min(k0 + size, last)
+        block = run.stepper.march_block(run.state, grid, k0, k1, run.every, run.n_steps - k0)
+        run.extend(block)
+        done = k1 if block.failed < 0 else block.failed - 1
+        run.n_steps += done - k0
+        run.t, run.state = grid.time(done), block.state
+        if block.failed >= 0:
+            run.fail(non_finite_message(run.t, grid.time(block.failed)))
+            return False
+        if run.progress is not None:
+            run.progress(run.t)
+    if last < grid.n:
+        run.fail(f"max_steps={run.max_steps} reached at t={run.t!r}; increase `max_steps`")
+        return False
+    return True
+
+
+def _segments(t0: float, t1: float, jumps: Sequence[Jump]) -> list[tuple[float, list]]:
+    """``[(end, jumps applied at the end), ...]``: the span cut at the jumps' times."""
+    times = sorted({time for time, _ in jumps if t0 <= time <= t1} | {t1})
+    return [(b, [apply for time, apply in jumps if time == b]) for b in times]
+
+
+def march(
+    stepper: Stepper,
+    t_span: tuple[float, float],
+    state: Any,
+    *,
+    h: float | None,
+    control: Control | None = None,
+    events: Sequence[Event] = (),
+    jumps: Sequence[Jump] = (),
+    record_every: int = 1,
+    max_steps: int | None = None,
+    dense_output: bool = False,
+    progress: Callable[[float], None] | None = None,
+) -> Outcome:
+    """March ``stepper`` from ``state`` at ``t_span[0]`` to ``t_span[1]``.
+
+    Parameters
+    ----------
+    stepper : Stepper
+        What makes one step (module docstring: the contract).
+    t_span : (float, float)
+        ``(t0, t1)``, ``t1 > t0``: checked by the caller.
+    state : object
+        The state at ``t0``, of the stepper's type.
+    h : float or None
+        The fixed step, or an adaptive run's first step.
+    control : Control, optional
+        Tolerances and controller: the run is adaptive. None: fixed steps of ``h``.
+    events : sequence of callables
+        ``g(t, state)``, with ``terminal`` and ``direction`` as in ``solve_ivp``.
+    jumps : sequence of (float, callable)
+        Maps applied to the state at given times (a step lands on each).
+    record_every : int
+        Record every this many accepted steps (and the first and last state).
+    max_steps : int, optional
+        Accepted steps allowed; no limit by default.
+    dense_output : bool
+        Keep every step's interpolant.
+    progress : callable, optional
+        ``progress(t)``, called as the run advances.
+
+    Returns
+    -------
+    Outcome
+        The record, the final state, the status and message, the counters and events.
+
+    Examples
+    --------
+    Explicit Euler on ``y' = −y`` as a stepper of two lines:
+
+    >>> class Euler(Stepper):
+    ...     def step(self, t, y, h):
+    ...         return y - h * y, None
+    >>> out = march(Euler(), (0.0, 1.0), np.array([1.0]), h=0.25, record_every=2)
+    >>> out.t.tolist(), out.records[0][:, 0].tolist(), out.status
+    ([0.0, 0.5, 1.0], [1.0, 0.5625, 0.31640625], <Status.SUCCESS: 0>)
+    """
+    t0, t1 = t_span
+    limit = math.inf if max_steps is None else max_steps
+    run = _Run(stepper, t0, state, list(events), record_every, limit, dense_output, progress)
+    compiled = stepper.blocks and control is None and not events and not dense_output
+    going = True
+    for end, applied in _segments(t0, t1, jumps):
+        if run.t < end:
+            if control is not None:
+                going, h = _adaptive(run, end, h, control)
+            elif compiled:
+                going = _blocks(run, end, h)
+            else:
+                going = _fixed(run, end, h)
+        if not going:
+            break
+        for apply in applied:
+            run.state = apply(run.state)
+        if applied:
+            run.record()
+        if progress is not None:
+            progress(run.t)
+    return run.outcome()
