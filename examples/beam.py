@@ -31,7 +31,7 @@ def run(n_elements: int = 20, n_steps: int = 2000) -> dict:
         "critical_dt": critical.dt,
         "critical_mode": critical.mode,
         "dt": dt,
-        "status": {s: r.status for s, r in runs.items()},
+        "status": {s: r.status.name for s, r in runs.items()},
         "midpoint_energy_drift": float(np.max(np.abs(midpoint.energy)) / scale),
         "implicit_energy_final": float(runs["implicit"].energy[-1] / scale),
         "newmark_minus_midpoint": float(np.max(np.abs(runs["newmark"].x - midpoint.x))),

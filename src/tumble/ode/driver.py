@@ -173,6 +173,8 @@ class Stepper:
     """Whether ``step`` overwrites its ``state`` (then no events, no adaptive control)."""
     time_axis: int = 0
     """The axis of :meth:`record`'s arrays along which samples are stacked."""
+    block_steps: int | None = None
+    """At most this many steps per :meth:`march_block` call (None: the whole grid)."""
 
     def step(self, t: float, state: Any, h: float) -> tuple[Any, np.ndarray | None]:
         raise NotImplementedError
@@ -388,6 +390,7 @@ def _blocks(run: _Run, t1: float, h: float) -> bool:
     grid = Grid(run.t, t1, h, fixed_step_count(run.t, t1, h))
     last = min(grid.n, run.max_steps - run.n_steps)
     size = max(1, grid.n // PROGRESS_BLOCKS) if run.progress is not None else grid.n
+    size = min(size, run.stepper.block_steps or size)
     for k0 in range(0, last, size):
         k1 = min(k0 + size, last)
         block = run.stepper.march_block(run.state, grid, k0, k1, run.every, run.n_steps - k0)

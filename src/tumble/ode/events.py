@@ -97,9 +97,3 @@ class EventTracker:
             if self.terminal[i] and self.counts[i] >= self.terminal[i]:
                 return t_root
         return None
-
-    def results(self, n: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
-        """``t_events`` (one (k,) array per event) and ``y_events`` (one (k, n) array each)."""
-        t_events = [np.array(ts, dtype=float) for ts in self.t_events]
-        y_events = [np.array(ys, dtype=float).reshape(-1, n) for ys in self.y_events]
-        return t_events, y_events

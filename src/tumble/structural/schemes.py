@@ -52,7 +52,6 @@ from __future__ import annotations
 
 import contextlib
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -60,6 +59,7 @@ import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from tumble._progress import progress_bar
+from tumble.ode.driver import Status, Stepper, march
 from tumble.structural import stepping, validation
 from tumble.structural.factorization import MAX_BANDWIDTH, band_structure, banded_cholesky
 from tumble.structural.stepping import Increments, State
@@ -182,11 +182,11 @@ class Response:
         Time step [s].
     tip_dof : int
         The system's monitored DOF.
-    status : str
-        ``"ok"``, or ``"diverged"`` if the state became non-finite (inf or NaN); the last
-        record is then that step's state.
+    status : Status
+        ``Status.SUCCESS``, or ``Status.FAILED`` if the state became non-finite (inf or
+        NaN); the run stops there and its last record is the last finite state.
     message : str
-        What happened, with the time.
+        What happened, naming the step's times on failure.
     solver : str
         How the steps were solved: ``"banded-cholesky"`` (the compiled loop) or
         ``"sparse-lu"`` (the NumPy reference loop); see :func:`integrate`. Empty if
@@ -200,7 +200,7 @@ class Response:
     scheme: str
     dt: float
     tip_dof: int
-    status: str
+    status: Status
     message: str
     solver: str = ""
 
@@ -212,7 +212,7 @@ class Response:
     @property
     def success(self) -> bool:
         """True unless the run diverged."""
-        return self.status == "ok"
+        return self.status.success
 
 
 def resolve_scheme(scheme: str | Scheme) -> Scheme:
@@ -275,7 +275,8 @@ def integrate(
     Returns
     -------
     Response
-        ``status == "diverged"`` if the state became non-finite; the run stops there.
+        ``status == Status.FAILED`` if the state became non-finite; the run stops there,
+        with the last finite state as its last record.
         ``solver`` says which path ran.
 
     Examples
@@ -294,37 +295,34 @@ def integrate(
     record_every = validation.count("record_every", record_every)
     state = _initial_state(system, x0, y0)
     C = None if damping is None else damping.matrix(system)
-    run, factor, solver = _choose_loop(scheme.matrix(system, C, dt), compiled)
-    steps = np.unique(np.r_[np.arange(0, n_steps + 1, record_every), n_steps])
-    block = stepping.block_size(n_steps, PROGRESS_UPDATES if progress else 1)
-    if not progress:  # one call per ~BLOCK_WORK DOF-steps: Ctrl-C is seen between calls
-        block = min(block, max(1, BLOCK_WORK // system.n_dofs))
+    block = min(
+        max(1, n_steps // PROGRESS_UPDATES) if progress else n_steps,
+        max(1, BLOCK_WORK // system.n_dofs),
+    )  # Ctrl-C is seen between blocks; fmt: skip
+    stepper, solver = _choose_stepper(system, scheme, dt, C, compiled, block)
+    start = stepper.start(state)
     with progress_bar(progress, n_steps, scheme.name) as update, _quiet_overflow():
 
-        def advance(count: int) -> None:
-            update(advance=count)
+        def advance(t: float) -> None:
+            update(completed=round(t / dt))
 
-        xs, ys, row, diverged = run(
-            system, scheme.increments(dt), factor, C, state, steps, advance, block
-        )
-    status, message = "ok", f"{n_steps} steps of {dt:g} s"
-    if diverged >= 0:
-        steps[row - 1] = diverged
-        status = "diverged"
-        message = f"the state became non-finite at step {diverged} (t = {diverged * dt:.6g} s)"
-    xs, ys = xs[:row], ys[:row]
-    with _quiet_overflow():
-        energy = system.energy(xs, ys)
-    return Response(
-        steps[:row] * dt, xs, ys, energy, scheme.name, dt, system.tip_dof, status, message, solver
-    )
+        out = march(stepper, (0.0, n_steps * dt), start, h=dt, record_every=record_every,
+                    progress=advance if progress else None)  # fmt: skip
+        energy = system.energy(*out.records)
+    xs, ys = out.records
+    return Response(out.t, xs, ys, energy, scheme.name, dt, system.tip_dof, out.status,
+                    out.message, solver)  # fmt: skip
 
 
-def _choose_loop(A: sp.spmatrix, compiled: bool | None) -> tuple[Callable, object, str]:
-    """The compiled loop and a banded Cholesky of ``A``, or the reference loop and SuperLU."""
+def _choose_stepper(
+    system: LinearSystem, scheme: Scheme, dt: float, C, compiled: bool | None, block: int
+) -> tuple[Stepper, str]:
+    """The compiled stepper with a banded Cholesky of the step matrix, or the reference
+    stepper with SuperLU; and the solver's name."""
+    A, k = scheme.matrix(system, C, dt), scheme.increments(dt)
     structure = band_structure(A)
     if not (structure.narrow if compiled is None else compiled):
-        return stepping.reference_loop, A, "sparse-lu"
+        return stepping.ReferenceStepper(system, k, A, C), "sparse-lu"
     if structure.bandwidth > MAX_BANDWIDTH:
         raise ValueError(
             f"compiled=True needs a step matrix of half-bandwidth <= {MAX_BANDWIDTH}; this "
@@ -332,11 +330,12 @@ def _choose_loop(A: sp.spmatrix, compiled: bool | None) -> tuple[Callable, objec
             "compiled=None to use the sparse LU"
         )
     try:
-        return stepping.compiled_loop, banded_cholesky(A, structure.order), "banded-cholesky"
+        factor = banded_cholesky(A, structure.order)
     except np.linalg.LinAlgError:  # κ(A) beyond 1/ε: a pivot came out <= 0
         if compiled:
             raise
-        return stepping.reference_loop, A, "sparse-lu"
+        return stepping.ReferenceStepper(system, k, A, C), "sparse-lu"
+    return stepping.CompiledStepper(system, k, factor, C, block), "banded-cholesky"
 
 
 def _step_count(n_steps: int | None, t_end: float | None, dt: float) -> int:

@@ -18,16 +18,16 @@ the small ``q`` rounds it relative to its own size. ``S y`` is summed afresh eac
 solve with the constant ``A`` and one pass over the elements for ``S Δx`` and ``S y``
 (plus a mass solve and ``S a`` for Newmark with ``2β ≠ γ``).
 
-:func:`reference_loop` runs it in Python with SuperLU (:func:`~tumble.structural.
-factorization.factorize`); :func:`compiled_loop` runs the same operations in the same
+:class:`ReferenceStepper` runs it in Python with SuperLU (:func:`~tumble.structural.
+factorization.factorize`); :class:`CompiledStepper` runs the same operations in the same
 order in :func:`tumble.structural.kernels.run_steps`, with the banded Cholesky of
-:class:`~tumble.structural.factorization.BandedCholesky`, many steps per call. Tests check
-that the two agree to round-off.
+:class:`~tumble.structural.factorization.BandedCholesky`, many steps per call. Both are
+steppers of the one driver, :func:`tumble.ode.driver.march`, which owns the time loop.
+Tests check that the two agree to round-off.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -35,6 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from tumble.ode.driver import Block, Grid, Stepper
 from tumble.structural.factorization import BandedCholesky, factorize
 from tumble.structural.kernels import all_finite, run_steps
 from tumble.structural.system import LinearSystem
@@ -86,8 +87,6 @@ class State:
 
 
 Solve = Callable[[NDArray], NDArray]
-Records = tuple[NDArray, NDArray, int, int]
-"""``(xs, ys, rows, diverged)``: records, rows filled, the step of divergence or -1."""
 
 
 def reference_step(
@@ -118,92 +117,94 @@ def reference_step(
         state.g = forces(state.y)
 
 
-def reference_loop(
-    system: LinearSystem,
-    k: Increments,
-    A: sp.spmatrix,
-    C: sp.spmatrix | None,
-    state: State,
-    record_steps: NDArray[np.int64],
-    advance: Callable[[int], None],
-    block: int,
-) -> Records:
-    """Step in Python with SuperLU; record at ``record_steps``; ``advance`` every ``block``."""
-    solve = factorize(A)
-    solve_mass = factorize(system.M) if k.mass_solve else None
-    xs, ys = _records(record_steps.size, state)
-    row = 1
-    for step in range(1, int(record_steps[-1]) + 1):
-        reference_step(state, k, system, solve, solve_mass, C)
-        finite = all_finite(state.x, state.y)
-        if not finite or step == record_steps[row]:
-            xs[row], ys[row], row = state.x, state.y, row + 1
-            if not finite:
-                return xs, ys, row, step
-        if step % block == 0:
-            advance(block)
-    return xs, ys, row, -1
+class ReferenceStepper(Stepper):
+    """The NumPy reference as a stepper of :func:`tumble.ode.driver.march`: SuperLU, one
+    :func:`reference_step` a step (on a copy, so that a non-finite step leaves the last
+    finite state)."""
+
+    def __init__(self, system: LinearSystem, k: Increments, A: sp.spmatrix, C):
+        self.system, self.k, self.C = system, k, C
+        self.solve = factorize(A)
+        self.solve_mass = factorize(system.M) if k.mass_solve else None
+
+    def start(self, state: State) -> State:
+        """The stepped state: ``state`` itself."""
+        return state
+
+    def step(self, t: float, state: State, h: float) -> tuple[State, None]:
+        new = State(state.x.copy(), state.y.copy(), state.q.copy(), state.g.copy())
+        reference_step(new, self.k, self.system, self.solve, self.solve_mass, self.C)
+        return new, None
+
+    def finite(self, state: State) -> bool:
+        return all_finite(state.x, state.y)
+
+    def record(self, state: State) -> tuple:
+        return state.x[None].copy(), state.y[None].copy()
 
 
-def compiled_loop(
-    system: LinearSystem,
-    k: Increments,
-    factor: BandedCholesky,
-    C: sp.spmatrix | None,
-    state: State,
-    record_steps: NDArray[np.int64],
-    advance: Callable[[int], None],
-    block: int,
-) -> Records:
-    """Step in :func:`~tumble.structural.kernels.run_steps`, ``block`` steps per call.
+class CompiledStepper(Stepper):
+    """:func:`~tumble.structural.kernels.run_steps` as a stepper of the driver: blocks of
+    steps compiled, with the banded Cholesky of :class:`~tumble.structural.factorization.
+    BandedCholesky`.
 
-    Everything is first put in the factor's DOF order (``factor.order``), so the loop
-    never permutes; the records are put back at the end.
+    Everything is put in the factor's DOF order (``factor.order``) once, so the loop never
+    permutes; :meth:`record` and the blocks' records put it back. A block that meets a
+    non-finite state is replayed from its start to the step before (the same operations,
+    so the same numbers): the run keeps its last finite state at no cost per step.
     """
-    order = factor.order
-    inverse = np.empty_like(order)
-    inverse[order] = np.arange(order.size)
-    mass = BandedCholesky.from_matrix(system.M, order) if k.mass_solve else factor
-    b = max(factor.bandwidth, mass.bandwidth)  # the loop is compiled for one bandwidth
-    factor, mass = _padded(factor, b), _padded(mass, b)
-    dof_map, *element_arrays = system.elements.kernel_arrays
-    permuted_map = np.where(dof_map >= 0, inverse[np.maximum(dof_map, 0)], -1).astype(np.int32)
-    frame = (permuted_map, *element_arrays)
-    permuted = [np.ascontiguousarray(v[order]) for v in (state.x, state.y, state.q, state.g)]
-    damping = _csr_arrays(None if C is None else sp.csr_matrix(C)[order][:, order])
-    n = order.size
-    work = tuple(np.zeros(n) for _ in range(4))
-    xs, ys = _records(record_steps.size, State(*permuted))
-    row, diverged, last = 1, -1, int(record_steps[-1])
-    coefficients = (k.dt, k.k_g, k.k_dy, k.k_sa, k.k_a)
-    for first in range(0, last, block):
-        row, diverged = run_steps(
-            first,
-            min(first + block, last),
-            record_steps,
-            row,
-            coefficients,
-            tuple(permuted),
-            frame,
-            _kernel_factor(factor),
-            _kernel_factor(mass),
-            damping,
-            work,
-            xs,
-            ys,
+
+    blocks = True
+
+    def __init__(self, system: LinearSystem, k: Increments, factor: BandedCholesky, C, block):
+        order = factor.order
+        self.order, self.inverse = order, np.empty_like(order)
+        self.inverse[order] = np.arange(order.size)
+        mass = BandedCholesky.from_matrix(system.M, order) if k.mass_solve else factor
+        b = max(factor.bandwidth, mass.bandwidth)  # the loop is compiled for one bandwidth
+        self.factor, self.mass = (
+            _kernel_factor(_padded(factor, b)),
+            _kernel_factor(_padded(mass, b)),
         )
-        if diverged >= 0:
-            break
-        advance(min(block, last - first))
-    if np.array_equal(order, np.arange(order.size)):
-        return xs, ys, row, diverged
-    return xs[:, inverse], ys[:, inverse], row, diverged
+        dof_map, *element_arrays = system.elements.kernel_arrays
+        permuted_map = np.where(dof_map >= 0, self.inverse[np.maximum(dof_map, 0)], -1)
+        self.frame = (permuted_map.astype(np.int32), *element_arrays)
+        self.damping = _csr_arrays(None if C is None else sp.csr_matrix(C)[order][:, order])
+        self.coefficients = (k.dt, k.k_g, k.k_dy, k.k_sa, k.k_a)
+        self.work = tuple(np.zeros(order.size) for _ in range(4))
+        self.block_steps = block
 
+    def start(self, state: State) -> State:
+        """``state`` in the factor's DOF order."""
+        return State(
+            *(np.ascontiguousarray(v[self.order]) for v in (state.x, state.y, state.q, state.g))
+        )
 
-def _records(n_records: int, state: State) -> tuple[NDArray, NDArray]:
-    xs, ys = np.empty((n_records, state.x.size)), np.empty((n_records, state.y.size))
-    xs[0], ys[0] = state.x, state.y
-    return xs, ys
+    def record(self, state: State) -> tuple:
+        return state.x[self.inverse][None], state.y[self.inverse][None]
+
+    def _run(self, state: State, k0: int, k1: int, steps: NDArray[np.int64], xs, ys):
+        vectors = (state.x, state.y, state.q, state.g)
+        return run_steps(k0, k1, steps, 0, self.coefficients, vectors, self.frame, self.factor,
+                         self.mass, self.damping, self.work, xs, ys)  # fmt: skip
+
+    def march_block(
+        self, state: State, grid: Grid, k0: int, k1: int, every: int, step0: int
+    ) -> Block:
+        k = np.arange(k0 + 1, k1 + 1)
+        steps = k[(step0 + k) % every == 0]
+        n = self.order.size
+        xs, ys = np.empty((steps.size + 1, n)), np.empty((steps.size + 1, n))
+        start = State(state.x.copy(), state.y.copy(), state.q.copy(), state.g.copy())
+        steps_padded = np.append(steps, -1)  # the kernel reads one entry past its last record
+        rows, failed = self._run(state, k0, k1, steps_padded, xs, ys)
+        if failed >= 0:  # replay to the step before, from the block's start
+            state, rows = start, int(np.searchsorted(steps, failed))
+            self._run(state, k0, failed - 1, steps_padded, xs, ys)
+        times = np.array([grid.time(int(step)) for step in steps[:rows]])
+        return Block(
+            times, (xs[:rows][:, self.inverse], ys[:rows][:, self.inverse]), state, failed
+        )
 
 
 def _kernel_factor(factor: BandedCholesky) -> tuple:
@@ -227,8 +228,3 @@ def _csr_arrays(C: sp.csr_matrix | None) -> tuple[NDArray, NDArray, NDArray]:
     if C is None:
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64), np.zeros(0)
     return C.indptr.astype(np.int64), C.indices.astype(np.int64), C.data.astype(float)
-
-
-def block_size(n_steps: int, updates: int) -> int:
-    """Steps per call so that a run advances its progress bar about ``updates`` times."""
-    return max(1, math.ceil(n_steps / updates))
