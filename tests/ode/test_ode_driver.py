@@ -1,0 +1,184 @@
+"""The driver's contract (tumble.ode.driver), on steppers small enough to check by hand."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from tumble.ode.control import fixed_step_count
+from tumble.ode.driver import Block, Control, Grid, Status, Stepper, march
+
+
+class Decay(Stepper):
+    """Explicit Euler on y' = −y: y_{k+1} = (1 − h) y_k, exactly representable for h = 2⁻ᵏ."""
+
+    def step(self, t, y, h):
+        return y - h * y, None
+
+
+class BlockDecay(Decay):
+    """The same steps, marched in blocks (as the compiled kernels are)."""
+
+    blocks = True
+
+    def __init__(self, block_steps=None):
+        self.block_steps = block_steps
+        self.calls = 0
+
+    def march_block(self, y, grid, k0, k1, every, step0):
+        self.calls += 1
+        times, samples = [], []
+        for k in range(k0 + 1, k1 + 1):
+            t_old = grid.time(k - 1)
+            new, _ = self.step(t_old, y, grid.time(k) - t_old)
+            if not np.all(np.isfinite(new)):
+                return Block(np.array(times), (np.array(samples),), y, failed=k)
+            y = new
+            if (step0 + k) % every == 0:
+                times.append(grid.time(k))
+                samples.append(y)
+        return Block(np.array(times), (np.array(samples).reshape(-1, y.size),), y)
+
+
+class Blowup(Decay):
+    """y' = y² by Euler: from y = 1 with h = 0.5 the state overflows after a few steps."""
+
+    def step(self, t, y, h):
+        return y + h * y * y * 1e100, None
+
+
+def run(stepper, **options):
+    options.setdefault("h", 0.25)
+    return march(stepper, (0.0, 1.0), np.array([1.0]), **options)
+
+
+def test_status_codes_are_scipys():
+    assert (Status.SUCCESS, Status.TERMINAL_EVENT, Status.FAILED) == (0, 1, -1)
+    assert Status.SUCCESS.success and Status.TERMINAL_EVENT.success
+    assert not Status.FAILED.success
+
+
+def test_fixed_steps_land_on_the_end_and_record_every_kth():
+    out = run(Decay(), h=0.3, record_every=2)
+    # steps end at 0.3, 0.6, 0.9, 1.0: recorded at the 2nd and 4th, and the start
+    np.testing.assert_allclose(out.t, [0.0, 0.6, 1.0])
+    assert out.t[-1] == 1.0 and out.n_steps == 4 and out.status == Status.SUCCESS
+    expected = [1.0, 0.7**2, 0.7**3 * 0.9]
+    np.testing.assert_allclose(out.records[0][:, 0], expected, rtol=1e-15)
+
+
+@pytest.mark.parametrize("block_steps", [None, 1, 3])
+@pytest.mark.parametrize("every", [1, 3, 7])
+def test_blocks_give_the_python_paths_record(block_steps, every):
+    python = march(Decay(), (0.0, 2.0), np.array([1.0]), h=0.1, record_every=every)
+    stepper = BlockDecay(block_steps)
+    blocks = march(stepper, (0.0, 2.0), np.array([1.0]), h=0.1, record_every=every)
+    np.testing.assert_array_equal(blocks.t, python.t)
+    np.testing.assert_array_equal(blocks.records[0], python.records[0])
+    assert blocks.n_steps == python.n_steps == 20
+    assert stepper.calls == (1 if block_steps is None else -(-20 // block_steps))
+
+
+def test_events_and_dense_output_take_the_python_path():
+    stepper = BlockDecay()
+    out = run(stepper, dense_output=True)
+    assert stepper.calls == 0 and len(out.interpolants) == out.n_steps == 4
+
+
+@pytest.mark.parametrize("make", [Blowup, lambda: type("B", (BlockDecay, Blowup), {})()])
+def test_a_non_finite_step_fails_and_keeps_the_last_finite_state(make):
+    with np.errstate(over="ignore"):
+        out = march(make(), (0.0, 10.0), np.array([1.0]), h=0.5)
+    assert out.status == Status.FAILED
+    assert np.all(np.isfinite(out.records[0])) and np.isfinite(out.state).all()
+    t_last = float(out.t[-1])
+    assert out.message.startswith("the state became non-finite")
+    assert f"from t={t_last!r} to t={t_last + 0.5!r}" in out.message
+
+
+@pytest.mark.parametrize("stepper", [Decay(), BlockDecay()], ids=["python", "blocks"])
+def test_max_steps_ends_the_run_with_a_failure_naming_t(stepper):
+    out = run(stepper, h=0.1, max_steps=4)
+    assert out.status == Status.FAILED and out.n_steps == 4
+    assert "max_steps=4" in out.message and f"t={float(out.t[-1])!r}" in out.message
+    assert out.t[-1] == pytest.approx(0.4)
+
+
+def test_a_jump_lands_a_step_and_replaces_the_sample_before_it():
+    def double(y):
+        return 2 * y
+
+    out = run(Decay(), h=0.25, jumps=[(0.5, double), (1.0, double)])
+    np.testing.assert_allclose(out.t, [0.0, 0.25, 0.5, 0.75, 1.0])
+    # 0.75² before the jump at 0.5, doubled; the jump at the end applies after the last step
+    np.testing.assert_allclose(out.records[0][:, 0], [1, 0.75, 1.125, 0.84375, 1.265625])
+
+
+def test_a_jump_at_the_start_replaces_the_initial_sample():
+    out = run(Decay(), jumps=[(0.0, lambda y: 3 * y)])
+    assert out.t[0] == 0.0 and out.t[1] == 0.25
+    assert out.records[0][0, 0] == 3.0
+
+
+def test_a_terminal_event_stops_the_run_where_it_crossed():
+    def below_half(t, y):
+        return y[0] - 0.5
+
+    below_half.terminal = True
+    out = march(Decay(), (0.0, 5.0), np.array([1.0]), h=0.25, events=[below_half])
+    assert out.status == Status.TERMINAL_EVENT and out.message == "A terminal event occurred."
+    # the default interpolant is a step of the stepper from the last state: (1 − τ) y
+    (t_root,) = out.t_events[0]
+    y_old = 0.75**2
+    assert t_root == pytest.approx(0.5 + (1 - 0.5 / y_old), abs=1e-12)
+    assert out.t[-1] == t_root and out.records[0][-1, 0] == pytest.approx(0.5, abs=1e-12)
+
+
+class Controlled(Stepper):
+    """Euler with the Heun estimate on y' = −y: error order 1."""
+
+    adaptive, error_order = True, 1
+
+    def step(self, t, y, h):
+        euler = y - h * y
+        heun = y - 0.5 * h * (y + euler)
+        return heun, heun - euler
+
+
+def test_adaptive_control_reaches_the_end_within_tolerance():
+    out = march(Controlled(), (0.0, 2.0), np.array([1.0]), h=0.1, control=Control(1e-6, 1e-9))
+    assert out.status == Status.SUCCESS and out.t[-1] == 2.0
+    assert out.records[0][-1, 0] == pytest.approx(np.exp(-2.0), rel=1e-4)
+    assert out.n_rejected >= 0 and out.n_steps > 10
+
+
+class ControlledBlowup(Controlled):
+    """The same pair on y' = y², whose solution 1/(1 − t) blows up at t = 1."""
+
+    def step(self, t, y, h):
+        euler = y + h * y * y
+        heun = y + 0.5 * h * (y * y + euler * euler)
+        return heun, heun - euler
+
+
+def test_adaptive_control_fails_below_the_minimum_step():
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = march(ControlledBlowup(), (0.0, 2.0), np.array([1.0]), h=0.1,
+                    control=Control(1e-3, 1e-6), max_steps=10**5)  # fmt: skip
+    assert out.status == Status.FAILED and "minimum" in out.message, out.message
+    assert abs(out.t[-1] - 1.0) < 1e-2  # where y = 1/(1 − t) blows up
+
+
+@given(
+    n=st.integers(min_value=1, max_value=60),
+    every=st.integers(min_value=1, max_value=9),
+    block=st.integers(min_value=1, max_value=25),
+)
+def test_record_times_are_every_kth_grid_time_and_the_end(n, every, block):
+    h = 1.0 / n
+    out = march(BlockDecay(block), (0.0, 1.0), np.array([1.0]), h=h, record_every=every)
+    grid = Grid(0.0, 1.0, h, fixed_step_count(0.0, 1.0, h))
+    expected = [0.0] + [grid.time(k) for k in range(every, grid.n + 1, every)]
+    if expected[-1] != 1.0:
+        expected.append(1.0)
+    np.testing.assert_array_equal(out.t, expected)
