@@ -28,6 +28,7 @@ Modules
 import logging
 
 from tumble import exact, mass, meshes, so3, structural
+from tumble._version import __version__ as __version__
 from tumble.ode import ButcherTableau, OdeResult, solve
 from tumble.rigid import (
     METHODS,
@@ -41,8 +42,6 @@ from tumble.rigid import (
     simulate,
     simulate_batch,
 )
-
-__version__ = "0.1.0"
 
 # The library never prints: it logs, and stays silent unless the application configures logging.
 logging.getLogger(__name__).addHandler(logging.NullHandler())

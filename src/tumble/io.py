@@ -36,6 +36,7 @@ from typing import Any
 import numpy as np
 
 from tumble._atomic import atomic_write
+from tumble._version import __version__
 from tumble.scenarios._base import ScenarioResult
 
 log = logging.getLogger(__name__)
@@ -100,14 +101,12 @@ def write_dataset(path: str | Path, datasets: Mapping[str, Any], attrs: Mapping[
     """
     import xarray as xr
 
-    import tumble
-
     groups = {
         f"/{name}" if name else "/": ds.assign_attrs(netcdf_attrs(ds.attrs))
         for name, ds in datasets.items()
     }
     root = groups.pop("/", xr.Dataset())
-    root = root.assign_attrs(netcdf_attrs({**attrs, "tumble_version": tumble.__version__}))
+    root = root.assign_attrs(netcdf_attrs({**attrs, "tumble_version": __version__}))
     tree = xr.DataTree.from_dict({"/": root, **groups})
     return atomic_write(path, lambda tmp: tree.to_netcdf(tmp, engine="h5netcdf"))
 
