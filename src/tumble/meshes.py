@@ -17,7 +17,7 @@ import numpy as np
 import trimesh
 from numpy.typing import ArrayLike
 
-from tumble.io import atomic_write
+from tumble._atomic import atomic_write
 from tumble.mass import axis_vector, validate_point, validate_positive, validate_torus_radii
 from tumble.so3 import validate_rotation
 
