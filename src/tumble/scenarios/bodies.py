@@ -218,7 +218,7 @@ class MeshBody(Section):
         return meshes.load(self.mesh).apply_scale(self.scale)
 
     def mass_properties(self) -> mass.MassProperties:
-        return mass.from_mesh(self.surface(), density=self.density)
+        return meshes.from_mesh(self.surface(), density=self.density)
 
     def label(self) -> str:
         return f"mesh {Path(self.mesh).name}"
