@@ -22,7 +22,7 @@ from rich.table import Table
 
 from tumble import scenarios
 from tumble.io import write_run_folder
-from tumble.scenarios._base import ScenarioResult
+from tumble.scenarios import ScenarioResult
 
 app = typer.Typer(
     help="Simulate rigid bodies and vibrating structures; write run folders.",

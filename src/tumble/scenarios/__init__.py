@@ -1,7 +1,8 @@
 """Built-in scenarios that reproduce the seeds, by name.
 
 Each scenario is a module with ``NAME``, ``SUMMARY`` and ``run(**options) -> ScenarioResult``
-(see :mod:`tumble.scenarios._base`). ``tumble run NAME`` runs one and writes its run folder.
+(see :mod:`tumble.scenarios._base`; :class:`ScenarioResult` is :class:`tumble.io.ScenarioResult`).
+``tumble run NAME`` runs one and writes its run folder.
 """
 
 from __future__ import annotations
@@ -9,7 +10,7 @@ from __future__ import annotations
 from importlib import import_module
 from types import ModuleType
 
-from tumble.scenarios._base import ScenarioResult
+from tumble.io import ScenarioResult
 
 _MODULES = {
     "projectile": "tumble.scenarios.projectile",

@@ -15,8 +15,8 @@ from dataclasses import asdict
 import numpy as np
 
 from tumble import scenarios
+from tumble.io import ScenarioResult
 from tumble.rigid.methods import METHODS
-from tumble.scenarios._base import ScenarioResult
 
 FREE_BODY_SCENARIOS = ("convergence", "sphere-exact", "t-handle", "torus-spin")
 """Scenarios whose body is torque-free with an exact solution (they define ``free_body()``)."""

@@ -35,10 +35,11 @@ import numpy as np
 from pydantic import AfterValidator, Field, model_validator
 
 from tumble import so3
+from tumble.io import ScenarioResult
 from tumble.rigid import Force, Gravity, Impulse, RigidBody, Torque, Trajectory, simulate
 from tumble.rigid.initial import check_steps, initial_attitude
 from tumble.rigid.methods import METHODS, get_method
-from tumble.scenarios._base import ScenarioResult, rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
 from tumble.scenarios.bodies import Body
 from tumble.scenarios.schema import (
     Matrix3,
