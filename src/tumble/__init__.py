@@ -18,8 +18,8 @@ Rigid bodies
                                     :class:`BatchTrajectory`
 Modules
 :mod:`tumble.so3`                   rotations: exp/log, dexp, quaternions, Euler angles
-:mod:`tumble.mass`                  mass properties: primitives, composites, meshes
-:mod:`tumble.meshes`                trimesh meshes of the same shapes
+:mod:`tumble.mass`                  mass properties: primitives, composites
+:mod:`tumble.meshes`                trimesh meshes of the same shapes; a mesh's mass properties
 :mod:`tumble.exact`                 exact references: sphere, projectile, free body
 :mod:`tumble.structural`            finite-element beams and their time-stepping schemes
 ==================================  ==========================================================
