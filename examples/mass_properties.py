@@ -16,7 +16,7 @@ def torus_sections_table(sections: tuple[int, ...]) -> list[dict[str, float]]:
     """Volume and principal inertia of the R = 1, r = 0.5, rho = 1 torus mesh per count."""
     rows = []
     for n in sections:
-        body = mass.from_mesh(meshes.torus(1.0, 0.5, n), density=1.0)
+        body = meshes.from_mesh(meshes.torus(1.0, 0.5, n), density=1.0)
         rows.append(
             {
                 "sections": n,

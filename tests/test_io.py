@@ -9,9 +9,8 @@ import xarray as xr
 
 import tumble
 from tumble import io, scenarios
-from tumble.io import atomic_write, write_json
+from tumble.io import ScenarioResult, atomic_write, write_json
 from tumble.rigid import Trajectory
-from tumble.scenarios._base import ScenarioResult
 
 
 def test_atomic_write_leaves_no_file_when_the_writer_crashes(tmp_path):

@@ -135,7 +135,7 @@ def test_mass_and_density_give_the_same_body():
     ids=["box", "hex_prism", "cylinder", "torus", "sphere"],
 )
 def test_primitive_matches_its_mesh(primitive, mesh, rtol):
-    meshed = mass.from_mesh(mesh, density=1.0)
+    meshed = meshes.from_mesh(mesh, density=1.0)
     assert meshed.mass == pytest.approx(primitive.mass, rel=rtol)
     scale = np.max(primitive.inertia)
     assert np.allclose(meshed.inertia, primitive.inertia, rtol=0, atol=rtol * scale)
@@ -144,13 +144,13 @@ def test_primitive_matches_its_mesh(primitive, mesh, rtol):
 def test_hex_prism_mesh_matches_on_a_slanted_axis():
     axis, center = [1.0, -2.0, 0.5], [0.1, 0.2, -0.3]
     primitive = mass.hex_prism(0.4, 1.1, density=3.0, axis=axis, center=center)
-    meshed = mass.from_mesh(meshes.hex_prism(0.4, 1.1, axis=axis, center=center), density=3.0)
+    meshed = meshes.from_mesh(meshes.hex_prism(0.4, 1.1, axis=axis, center=center), density=3.0)
     assert np.allclose(meshed.inertia, primitive.inertia, rtol=0, atol=1e-12)
     assert np.allclose(meshed.com, center, rtol=0, atol=1e-12)
 
 
 def test_t_handle_mesh_converges_to_the_primitive():
-    meshed = mass.from_mesh(meshes.t_handle(256), density=6700.0)
+    meshed = meshes.from_mesh(meshes.t_handle(256), density=6700.0)
     # Polygon error (2π/256)²/6 = 1e-4 relative (measured 1.0e-4 to 1.2e-4).
     scale = T_HANDLE_INERTIA.max()
     assert np.allclose(meshed.inertia, np.diag(T_HANDLE_INERTIA), rtol=0, atol=2e-4 * scale)
@@ -302,7 +302,7 @@ def test_rotated_refuses_a_non_rotation():
 
 def test_from_mesh_reads_a_file(tmp_path):
     path = meshes.save(meshes.box([1.0, 2.0, 3.0]), tmp_path / "box.stl")
-    body = mass.from_mesh(path, density=2.0)
+    body = meshes.from_mesh(path, density=2.0)
     assert body.mass == pytest.approx(12.0, rel=1e-12)
     assert np.allclose(body.inertia, np.diag([13.0, 10.0, 5.0]), rtol=1e-12, atol=0)
 
@@ -311,22 +311,22 @@ def test_from_mesh_refuses_an_open_mesh():
     mesh = meshes.box([1.0, 1.0, 1.0])
     mesh.update_faces(np.arange(len(mesh.faces) - 1))
     with pytest.raises(ValueError, match=r"mesh_or_path must be a closed \(watertight\)"):
-        mass.from_mesh(mesh, density=1.0)
+        meshes.from_mesh(mesh, density=1.0)
 
 
 def test_from_mesh_refuses_an_inside_out_mesh_with_the_remedy():
     mesh = meshes.torus(1.0, 0.5, 16)
     mesh.invert()
     with pytest.raises(ValueError, match=r"outward-oriented.*volume -4\.68.*fix_inside_out=True"):
-        mass.from_mesh(mesh, density=1.0)
+        meshes.from_mesh(mesh, density=1.0)
 
 
 def test_from_mesh_flips_an_inside_out_mesh_with_a_warning_when_asked():
     mesh = meshes.torus(1.0, 0.5, 16)
-    expected = mass.from_mesh(mesh, density=1.0)
+    expected = meshes.from_mesh(mesh, density=1.0)
     mesh.invert()
     with pytest.warns(UserWarning, match="inside-out"):
-        body = mass.from_mesh(mesh, density=1.0, fix_inside_out=True)
+        body = meshes.from_mesh(mesh, density=1.0, fix_inside_out=True)
     assert np.allclose(body.inertia, expected.inertia, rtol=1e-14, atol=0)
     assert mesh.volume < 0  # the caller's mesh is left as it was
 
@@ -337,21 +337,21 @@ def test_from_mesh_refuses_inconsistent_winding():
     faces[0] = faces[0][::-1]
     mesh.faces = faces
     with pytest.raises(ValueError, match=r"mesh_or_path must have consistently wound faces"):
-        mass.from_mesh(mesh, density=1.0)
+        meshes.from_mesh(mesh, density=1.0)
 
 
 def test_from_mesh_refuses_an_unreadable_file(tmp_path):
     path = tmp_path / "broken.stl"
     path.write_bytes(b"not an stl file")
     with pytest.raises(ValueError, match=r"path must be a mesh file with triangles; .*broken"):
-        mass.from_mesh(path, density=1.0)
+        meshes.from_mesh(path, density=1.0)
 
 
 def test_from_mesh_refuses_a_non_mesh():
     with pytest.raises(ValueError, match=r"mesh_or_path must be a trimesh.Trimesh .* got 42"):
-        mass.from_mesh(42, density=1.0)
+        meshes.from_mesh(42, density=1.0)
 
 
 def test_from_mesh_refuses_bad_density():
     with pytest.raises(ValueError, match=r"density must be a finite number > 0; got -1"):
-        mass.from_mesh(meshes.box([1.0, 1.0, 1.0]), density=-1)
+        meshes.from_mesh(meshes.box([1.0, 1.0, 1.0]), density=-1)

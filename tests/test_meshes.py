@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from tumble import mass, meshes
+from tumble import meshes
 
 # SPEC §4 closed forms for the torus R = 1, r = 0.5, rho = 1.
 TORUS_VOLUME = 2 * np.pi**2 * 1.0 * 0.5**2
@@ -34,7 +34,7 @@ def test_generated_mesh_is_closed_and_outward(name):
 
 def test_torus_mesh_is_placed_on_its_axis():
     mesh = meshes.torus(1.0, 0.5, 32, axis="x", center=(0.0, 5.0, 0.0))
-    body = mass.from_mesh(mesh, density=1.0)
+    body = meshes.from_mesh(mesh, density=1.0)
     assert np.allclose(body.com, [0.0, 5.0, 0.0], rtol=0, atol=1e-12)
     assert np.argmax(body.inertia.diagonal()) == 0  # the largest moment is about x
 
@@ -49,7 +49,7 @@ def test_torus_mesh_converges_at_second_order():
     sections = np.array([16, 32, 64, 128])
     errors = []
     for n in sections:
-        body = mass.from_mesh(meshes.torus(1.0, 0.5, int(n)), density=1.0)
+        body = meshes.from_mesh(meshes.torus(1.0, 0.5, int(n)), density=1.0)
         relative = [body.mass / TORUS_VOLUME - 1, *(body.inertia.diagonal() / TORUS_INERTIA - 1)]
         errors.append(np.abs(relative))
     errors = np.array(errors)
@@ -63,7 +63,7 @@ def test_torus_mesh_with_64_sections_is_close_to_the_seed_mesh():
     # The seed's torus.stl is unknown; 64 x 64 sections lands within 3e-4 of its printed
     # values (4.9190 vs 4.918, 3.2222 vs 3.223, 5.8304 vs 5.832): the same size of error
     # (0.3-0.5 % below exact) but not the same digits. See docs/mass-properties.md.
-    body = mass.from_mesh(meshes.torus(1.0, 0.5, 64), density=1.0)
+    body = meshes.from_mesh(meshes.torus(1.0, 0.5, 64), density=1.0)
     assert body.mass == pytest.approx(SEED_VOLUME, rel=3e-4)
     assert np.allclose(body.inertia.diagonal(), SEED_INERTIA, rtol=3e-4, atol=0)
 
@@ -71,7 +71,7 @@ def test_torus_mesh_with_64_sections_is_close_to_the_seed_mesh():
 def test_torus_mesh_with_80_by_53_sections_prints_the_seed_values():
     # Found by searching major x minor = 3..128 x 3..128 (docs/mass-properties.md); 64 x 64
     # does not round to the seed's three decimals.
-    body = mass.from_mesh(meshes.torus(1.0, 0.5, 80, minor_sections=53), density=1.0)
+    body = meshes.from_mesh(meshes.torus(1.0, 0.5, 80, minor_sections=53), density=1.0)
     printed = np.round([body.mass, *body.inertia.diagonal()], 3)
     assert np.array_equal(printed, [SEED_VOLUME, *SEED_INERTIA])
 

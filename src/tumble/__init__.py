@@ -18,31 +18,43 @@ Rigid bodies
                                     :class:`BatchTrajectory`
 Modules
 :mod:`tumble.so3`                   rotations: exp/log, dexp, quaternions, Euler angles
-:mod:`tumble.mass`                  mass properties: primitives, composites, meshes
-:mod:`tumble.meshes`                trimesh meshes of the same shapes
+:mod:`tumble.mass`                  mass properties: primitives, composites
+:mod:`tumble.meshes`                trimesh meshes of the same shapes; a mesh's mass properties
 :mod:`tumble.exact`                 exact references: sphere, projectile, free body
 :mod:`tumble.structural`            finite-element beams and their time-stepping schemes
 ==================================  ==========================================================
+
+Every submodule and name here is imported on first use (PEP 562), so ``import tumble`` is
+quick and loads neither numba nor trimesh, xarray or plotly.
 """
 
+from __future__ import annotations
+
+import importlib
 import logging
+from typing import TYPE_CHECKING, Any
 
-from tumble import exact, mass, meshes, so3, structural
-from tumble.ode import ButcherTableau, OdeResult, solve
-from tumble.rigid import (
-    METHODS,
-    BatchTrajectory,
-    Force,
-    Gravity,
-    Impulse,
-    RigidBody,
-    Torque,
-    Trajectory,
-    simulate,
-    simulate_batch,
-)
-
-__version__ = "0.1.0"
+if TYPE_CHECKING:  # what static type checkers see; at run time __getattr__ imports on demand
+    from tumble import exact, mass, meshes, so3, structural
+    from tumble import io as io
+    from tumble import ode as ode
+    from tumble import rigid as rigid
+    from tumble import scenarios as scenarios
+    from tumble import viz as viz
+    from tumble._version import __version__ as __version__
+    from tumble.ode import ButcherTableau, OdeResult, solve
+    from tumble.rigid import (
+        METHODS,
+        BatchTrajectory,
+        Force,
+        Gravity,
+        Impulse,
+        RigidBody,
+        Torque,
+        Trajectory,
+        simulate,
+        simulate_batch,
+    )
 
 # The library never prints: it logs, and stays silent unless the application configures logging.
 logging.getLogger(__name__).addHandler(logging.NullHandler())
@@ -67,3 +79,45 @@ __all__ = [
     "solve",
     "structural",
 ]
+
+_SUBMODULES = frozenset(
+    {"exact", "io", "mass", "meshes", "ode", "rigid", "scenarios", "so3", "structural", "viz"}
+)
+"""Modules reachable as ``tumble.<name>`` after a bare ``import tumble``."""
+_NAMES = {
+    **dict.fromkeys(["ButcherTableau", "OdeResult", "solve"], "tumble.ode"),
+    **dict.fromkeys(
+        [
+            "METHODS",
+            "BatchTrajectory",
+            "Force",
+            "Gravity",
+            "Impulse",
+            "RigidBody",
+            "Torque",
+            "Trajectory",
+            "simulate",
+            "simulate_batch",
+        ],
+        "tumble.rigid",
+    ),
+    "__version__": "tumble._version",
+}
+"""Each public name and the module it comes from."""
+
+
+def __getattr__(name: str) -> Any:
+    """Import the submodule or public name ``name`` on first use, then keep it (PEP 562)."""
+    if name in _SUBMODULES:
+        value = importlib.import_module(f"{__name__}.{name}")
+    elif name in _NAMES:
+        value = getattr(importlib.import_module(_NAMES[name]), name)
+    else:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    """The module's attributes, the ones not yet imported included."""
+    return sorted({*globals(), *_SUBMODULES, *_NAMES})

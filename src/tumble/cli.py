@@ -22,7 +22,7 @@ from rich.table import Table
 
 from tumble import scenarios
 from tumble.io import write_run_folder
-from tumble.scenarios._base import ScenarioResult
+from tumble.scenarios import ScenarioResult
 
 app = typer.Typer(
     help="Simulate rigid bodies and vibrating structures; write run folders.",
@@ -316,13 +316,13 @@ def mass_properties(
     ] = False,
 ) -> None:
     """Mass, centre of mass, inertia and principal axes of a mesh of uniform density."""
-    from tumble import mass, meshes
+    from tumble import meshes
 
     with _reported(), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
             mesh = meshes.load(mesh_file)
-            properties = mass.from_mesh(mesh, density=density, fix_inside_out=fix_inside_out)
+            properties = meshes.from_mesh(mesh, density=density, fix_inside_out=fix_inside_out)
         except ValueError as error:  # name the command-line option, not the argument
             message = str(error).replace("fix_inside_out=True", "--fix-inside-out")
             raise ValueError(message) from None

@@ -1,6 +1,7 @@
-"""Run folders: every file written whole or not at all.
+"""Run folders: what a scenario returns, and every file written whole or not at all.
 
-A run folder holds
+A scenario's :class:`ScenarioResult` (headline numbers, datasets, picture writers) becomes a
+run folder, which holds
 
 * ``data.nc`` — the trajectories as netCDF-4 (h5netcdf): one group per run, the run's settings
   (scenario, method, step or tolerances, mass, inertia, tumble version) as root attributes;
@@ -29,16 +30,55 @@ from __future__ import annotations
 import json
 import logging
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from tumble._atomic import atomic_write
-from tumble.scenarios._base import ScenarioResult
+from tumble._version import __version__
 
 log = logging.getLogger(__name__)
+
+FigureWriter = Callable[[Path], None]
+"""Draws one file (a picture, an animation) at the path it is given; the drawing is in viz."""
+
+
+@dataclass
+class ScenarioResult:
+    """The outcome of one scenario run: pure data and writers, nothing written yet.
+
+    A scenario's ``run(**options)`` returns one (:mod:`tumble.scenarios`);
+    :func:`write_run_folder` turns it into a run folder.
+
+    Attributes
+    ----------
+    name : str
+        The scenario's name.
+    summary : dict
+        Headline numbers and settings, JSON-serialisable (written to ``summary.json``).
+    data : dict
+        Arrays and objects (trajectories, datasets) for further use; not written as-is.
+    figures : list of (str, callable)
+        ``(file_name, writer)`` pairs; ``writer(path)`` draws the file at ``path``.
+    datasets : dict of str to xarray.Dataset
+        Written to ``data.nc``, one netCDF group per entry (a single entry named ``""`` is
+        the root group).
+    attrs : dict
+        The run's settings (method, step or tolerances, mass, inertia, …), written as the
+        root attributes of ``data.nc``; numbers, strings and lists of numbers only.
+    animations : list of (str, callable)
+        Like ``figures``, for the slower outputs (``animation.gif``, ``view.html``).
+    """
+
+    name: str
+    summary: dict[str, Any]
+    data: dict[str, Any] = field(default_factory=dict)
+    figures: list[tuple[str, FigureWriter]] = field(default_factory=list)
+    datasets: dict[str, Any] = field(default_factory=dict)
+    attrs: dict[str, Any] = field(default_factory=dict)
+    animations: list[tuple[str, FigureWriter]] = field(default_factory=list)
 
 
 def _finite(value: Any) -> Any:
@@ -100,14 +140,12 @@ def write_dataset(path: str | Path, datasets: Mapping[str, Any], attrs: Mapping[
     """
     import xarray as xr
 
-    import tumble
-
     groups = {
         f"/{name}" if name else "/": ds.assign_attrs(netcdf_attrs(ds.attrs))
         for name, ds in datasets.items()
     }
     root = groups.pop("/", xr.Dataset())
-    root = root.assign_attrs(netcdf_attrs({**attrs, "tumble_version": tumble.__version__}))
+    root = root.assign_attrs(netcdf_attrs({**attrs, "tumble_version": __version__}))
     tree = xr.DataTree.from_dict({"/": root, **groups})
     return atomic_write(path, lambda tmp: tree.to_netcdf(tmp, engine="h5netcdf"))
 

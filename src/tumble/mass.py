@@ -1,10 +1,11 @@
-"""Mass properties: mass, centre of mass and inertia tensor, primitives and meshes.
+"""Mass properties: mass, centre of mass and inertia tensor, primitives and composites.
 
 Units are SI (kg, m, kg m²). A :class:`MassProperties` holds the inertia tensor about its
 own centre of mass, in the axes of the frame its ``com`` is given in. Primitives are solids
 of uniform density, built from ``density=`` (kg/m³) or ``mass=`` (kg), placed at ``center``
 with their symmetry ``axis`` along "x", "y", "z" or any vector. Composites add by the
-parallel-axis theorem: ``handle + shaft``.
+parallel-axis theorem: ``handle + shaft``. The mass properties of a closed
+triangle mesh are :func:`tumble.meshes.from_mesh`.
 
 Inertia formulas (``m`` the mass, about the centre of mass; standard closed forms):
 
@@ -25,18 +26,12 @@ plane, so half of that about any in-plane axis.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
-from os import PathLike
-from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from tumble.so3 import validate_rotation
-
-if TYPE_CHECKING:
-    import trimesh
 
 SYMMETRY_RTOL = 1e-9
 """Allowed |I - Iᵀ| relative to max |I| before an inertia is refused as not symmetric."""
@@ -468,58 +463,3 @@ def t_handle(
     )
     body = handle + shaft
     return body.translated(-body.com)
-
-
-def from_mesh(
-    mesh_or_path: trimesh.Trimesh | str | PathLike[str],
-    *,
-    density: float,
-    fix_inside_out: bool = False,
-) -> MassProperties:
-    """Mass properties of a closed triangle mesh of uniform ``density`` (kg/m³).
-
-    Uses trimesh's exact polyhedral integrals (Eberly, *Polyhedral Mass Properties*); the
-    inertia is about the centre of mass, in the mesh's axes. The mesh must be closed
-    (watertight) and consistently wound. An inside-out mesh (negative signed volume) is
-    refused, unless ``fix_inside_out=True``: then its faces are flipped (on a copy) with a
-    ``UserWarning``.
-
-    Parameters
-    ----------
-    mesh_or_path : trimesh.Trimesh or path
-        A mesh, or a file that :func:`tumble.meshes.load` reads (STL, OBJ, PLY, ...).
-    density : float
-        Density (kg/m³), > 0.
-    fix_inside_out : bool
-        Flip an inside-out mesh instead of refusing it.
-
-    Returns
-    -------
-    MassProperties
-
-    Examples
-    --------
-    >>> from tumble import meshes
-    >>> round(from_mesh(meshes.box([1.0, 2.0, 3.0]), density=2.0).mass, 12)
-    12.0
-    """
-    import trimesh
-
-    from tumble import meshes
-
-    rho = validate_positive(density, name="density")
-    if isinstance(mesh_or_path, (str, PathLike)):
-        mesh_or_path = meshes.load(mesh_or_path)
-    mesh = meshes.validate_solid(mesh_or_path, name="mesh_or_path")
-    triangles = mesh.triangles
-    if mesh.volume < 0:
-        if not fix_inside_out:
-            raise ValueError(
-                f"mesh_or_path must be outward-oriented; got an inside-out mesh (volume "
-                f"{mesh.volume:.6g} < 0). Flip it with mesh.invert(), or pass "
-                "fix_inside_out=True."
-            )
-        warnings.warn("mesh is inside-out (negative volume); flipped", UserWarning, 2)
-        triangles = triangles[:, ::-1]
-    props = trimesh.triangles.mass_properties(triangles, density=rho)
-    return MassProperties(props.mass, props.center_mass, props.inertia)

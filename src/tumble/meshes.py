@@ -2,24 +2,34 @@
 
 Every generator returns a closed (watertight), consistently and outward-wound
 ``trimesh.Trimesh`` whose vertices lie on the exact surface, so its mass properties
-(:func:`tumble.mass.from_mesh`) converge to the closed forms of :mod:`tumble.mass` as the
-section count grows, with error ∝ 1/sections². They replace the seeds' ``torus.stl`` and
+(:func:`from_mesh`) converge to the closed forms of :mod:`tumble.mass` as the section count
+grows, with error ∝ 1/sections². They replace the seeds' ``torus.stl`` and
 ``Prism_hexagon.stl``, which are not available. ``axis`` and ``center`` mean what they mean
-in :mod:`tumble.mass`.
+in :mod:`tumble.mass`. trimesh is imported inside the functions, on first use.
 """
 
 from __future__ import annotations
 
+import warnings
 from os import PathLike
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import trimesh
 from numpy.typing import ArrayLike
 
-from tumble.io import atomic_write
-from tumble.mass import axis_vector, validate_point, validate_positive, validate_torus_radii
+from tumble._atomic import atomic_write
+from tumble.mass import (
+    MassProperties,
+    axis_vector,
+    validate_point,
+    validate_positive,
+    validate_torus_radii,
+)
 from tumble.so3 import validate_rotation
+
+if TYPE_CHECKING:
+    import trimesh
 
 DEFAULT_SECTIONS = 64
 """Default number of sections around a circle (torus both ways, cylinder)."""
@@ -37,6 +47,8 @@ def _sections(value: int, name: str) -> int:
 
 def _placement(axis: str | ArrayLike, center: ArrayLike) -> np.ndarray:
     """4×4 transform taking the mesh's local z axis to ``axis`` and its origin to ``center``."""
+    import trimesh
+
     transform = trimesh.geometry.align_vectors([0.0, 0.0, 1.0], axis_vector(axis))
     transform[:3, 3] = validate_point(center, name="center")
     return transform
@@ -74,6 +86,8 @@ def torus(
     >>> round(float(torus(1.0, 0.5, 64).volume), 4)  # exact 2π²Rr² = 4.9348
     4.919
     """
+    import trimesh
+
     R, r = validate_torus_radii(major_radius, minor_radius)
     n = _sections(sections, "sections")
     k = n if minor_sections is None else _sections(minor_sections, "minor_sections")
@@ -98,6 +112,8 @@ def cylinder(
     >>> mesh.is_watertight, mesh.extents.round(6).tolist()
     (True, [2.0, 2.0, 2.0])
     """
+    import trimesh
+
     a = validate_positive(radius, name="radius")
     L = validate_positive(length, name="length")
     n = _sections(sections, "sections")
@@ -136,6 +152,8 @@ def box(
     >>> round(float(box([1.0, 2.0, 3.0]).volume), 12)
     6.0
     """
+    import trimesh
+
     sides = np.asarray(extents, dtype=float)
     if sides.shape != (3,) or not np.all(np.isfinite(sides) & (sides > 0)):
         raise ValueError(f"extents must be three finite lengths > 0 (m); got {extents!r}")
@@ -156,6 +174,8 @@ def sphere(
     >>> len(sphere(1.0, 2).faces)
     320
     """
+    import trimesh
+
     a = validate_positive(radius, name="radius")
     if isinstance(subdivisions, bool) or not isinstance(subdivisions, (int, np.integer)):
         raise ValueError(f"subdivisions must be an integer >= 0; got {subdivisions!r}")
@@ -179,6 +199,8 @@ def t_handle(sections: int = DEFAULT_SECTIONS) -> trimesh.Trimesh:
     >>> mesh.is_watertight, mesh.body_count
     (True, 2)
     """
+    import trimesh
+
     handle = cylinder(0.01, 0.08, sections, axis="y", center=(-0.01, 0.0, 0.0))
     shaft = cylinder(0.01, 0.04, sections, axis="x", center=(0.02, 0.0, 0.0))
     return trimesh.util.concatenate([handle, shaft])
@@ -201,6 +223,8 @@ def validate_solid(mesh: object, *, name: str = "mesh") -> trimesh.Trimesh:
     >>> validate_solid(box([1.0, 1.0, 1.0])).is_watertight
     True
     """
+    import trimesh
+
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ValueError(
             f"{name} must be a trimesh.Trimesh with faces or a mesh file path; got {mesh!r}"
@@ -255,6 +279,8 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
     ...     print(round(float(load(path).volume), 9))
     6.0
     """
+    import trimesh
+
     file = Path(path)
     if not file.is_file():
         raise ValueError(f"path must be an existing mesh file; got {str(path)!r} (not found)")
@@ -291,6 +317,8 @@ def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
     ...     print(save(box([1.0, 1.0, 1.0]), pathlib.Path(folder) / "cube.stl").name)
     cube.stl
     """
+    import trimesh
+
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ValueError(f"mesh must be a trimesh.Trimesh with faces; got {mesh!r}")
     file = Path(path)
@@ -298,3 +326,55 @@ def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
     if not file.parent.is_dir():
         raise ValueError(f"path must be in an existing folder; got {str(path)!r}")
     return atomic_write(file, lambda temporary: mesh.export(temporary, file_type=file_type))
+
+
+def from_mesh(
+    mesh_or_path: trimesh.Trimesh | str | PathLike[str],
+    *,
+    density: float,
+    fix_inside_out: bool = False,
+) -> MassProperties:
+    """Mass properties of a closed triangle mesh of uniform ``density`` (kg/m³).
+
+    Uses trimesh's exact polyhedral integrals (Eberly, *Polyhedral Mass Properties*); the
+    inertia is about the centre of mass, in the mesh's axes. The mesh must be closed
+    (watertight) and consistently wound. An inside-out mesh (negative signed volume) is
+    refused, unless ``fix_inside_out=True``: then its faces are flipped (on a copy) with a
+    ``UserWarning``.
+
+    Parameters
+    ----------
+    mesh_or_path : trimesh.Trimesh or path
+        A mesh, or a file that :func:`load` reads (STL, OBJ, PLY, ...).
+    density : float
+        Density (kg/m³), > 0.
+    fix_inside_out : bool
+        Flip an inside-out mesh instead of refusing it.
+
+    Returns
+    -------
+    MassProperties
+
+    Examples
+    --------
+    >>> round(from_mesh(box([1.0, 2.0, 3.0]), density=2.0).mass, 12)
+    12.0
+    """
+    import trimesh
+
+    rho = validate_positive(density, name="density")
+    if isinstance(mesh_or_path, (str, PathLike)):
+        mesh_or_path = load(mesh_or_path)
+    mesh = validate_solid(mesh_or_path, name="mesh_or_path")
+    triangles = mesh.triangles
+    if mesh.volume < 0:
+        if not fix_inside_out:
+            raise ValueError(
+                f"mesh_or_path must be outward-oriented; got an inside-out mesh (volume "
+                f"{mesh.volume:.6g} < 0). Flip it with mesh.invert(), or pass "
+                "fix_inside_out=True."
+            )
+        warnings.warn("mesh is inside-out (negative volume); flipped", UserWarning, 2)
+        triangles = triangles[:, ::-1]
+    props = trimesh.triangles.mass_properties(triangles, density=rho)
+    return MassProperties(props.mass, props.center_mass, props.inertia)

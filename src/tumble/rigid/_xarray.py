@@ -11,7 +11,7 @@ def trajectory_dataset(trajectory):
     """Build the dataset: every array with its dimensions, units and the run's settings."""
     import xarray as xr
 
-    import tumble
+    from tumble._version import __version__
 
     vec, mat = ("time", "axis"), ("time", "row", "col")
     variables = {
@@ -36,7 +36,7 @@ def trajectory_dataset(trajectory):
         "settings": json.dumps(settings),
         "status": trajectory.status,
         "message": trajectory.message,
-        "tumble_version": tumble.__version__,
+        "tumble_version": __version__,
     }
     coords = {
         "time": ("time", trajectory.t, {"units": "s"}),

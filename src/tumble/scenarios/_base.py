@@ -1,4 +1,4 @@
-"""What a scenario is: a function that computes, and a result that knows how to be written.
+"""What a scenario is, and the pieces the rigid-body scenarios share.
 
 A built-in scenario is a module in :mod:`tumble.scenarios` with
 
@@ -6,57 +6,20 @@ A built-in scenario is a module in :mod:`tumble.scenarios` with
 * ``SUMMARY`` — one line for ``tumble list``,
 * ``run(**options) -> ScenarioResult`` — pure computation, no files, no printing.
 
-The result carries the headline numbers (``summary``, JSON-serialisable), the arrays a
-reader may want (``data``), the datasets written to ``data.nc`` (``datasets``, with the run's
-settings in ``attrs``), and the pictures as ``(file name, writer)`` pairs: ``figures`` (PNGs)
-and ``animations`` (``animation.gif``, ``view.html``; left out with ``--no-animation``). A
-writer is a callable that takes a path and draws one file there (the drawing lives in
-:mod:`tumble.viz`). :func:`tumble.io.write_run_folder` turns a result into a run folder.
+:class:`tumble.io.ScenarioResult` (also ``tumble.scenarios.ScenarioResult``) is defined beside
+the run folders it becomes (:func:`tumble.io.write_run_folder`). The helpers here build its
+animations, datasets and attributes for a rigid-body run.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-FigureWriter = Callable[[Path], None]
-
-
-@dataclass
-class ScenarioResult:
-    """The outcome of one scenario run.
-
-    Attributes
-    ----------
-    name : str
-        The scenario's name.
-    summary : dict
-        Headline numbers and settings, JSON-serialisable (written to ``summary.json``).
-    data : dict
-        Arrays and objects (trajectories, datasets) for further use; not written as-is.
-    figures : list of (str, callable)
-        ``(file_name, writer)`` pairs; ``writer(path)`` draws the file at ``path``.
-    datasets : dict of str to xarray.Dataset
-        Written to ``data.nc``, one netCDF group per entry (a single entry named ``""`` is
-        the root group).
-    attrs : dict
-        The run's settings (method, step or tolerances, mass, inertia, …), written as the
-        root attributes of ``data.nc``; numbers, strings and lists of numbers only.
-    animations : list of (str, callable)
-        Like ``figures``, for the slower outputs (``animation.gif``, ``view.html``).
-    """
-
-    name: str
-    summary: dict[str, Any]
-    data: dict[str, Any] = field(default_factory=dict)
-    figures: list[tuple[str, FigureWriter]] = field(default_factory=list)
-    datasets: dict[str, Any] = field(default_factory=dict)
-    attrs: dict[str, Any] = field(default_factory=dict)
-    animations: list[tuple[str, FigureWriter]] = field(default_factory=list)
+from tumble.io import FigureWriter
 
 
 def rigid_animations(

@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from tumble import structural
-from tumble.scenarios._base import ScenarioResult
+from tumble.io import ScenarioResult
 from tumble.structural import validation
 from tumble.viz import structural as viz
 

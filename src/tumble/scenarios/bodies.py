@@ -36,10 +36,9 @@ ValueError: body.radius = -1: must be > 0
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal, Union
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Literal, Union
 
 import numpy as np
-import trimesh
 from pydantic import (
     AfterValidator,
     Discriminator,
@@ -60,6 +59,9 @@ from tumble.scenarios.schema import (
     check_table,
     custom_error,
 )
+
+if TYPE_CHECKING:
+    import trimesh
 
 
 def _axis(value: Any) -> str | list[float]:
@@ -218,7 +220,7 @@ class MeshBody(Section):
         return meshes.load(self.mesh).apply_scale(self.scale)
 
     def mass_properties(self) -> mass.MassProperties:
-        return mass.from_mesh(self.surface(), density=self.density)
+        return meshes.from_mesh(self.surface(), density=self.density)
 
     def label(self) -> str:
         return f"mesh {Path(self.mesh).name}"
@@ -274,6 +276,8 @@ class Composite(Section):
         return sum(part.mass_properties() for part in self.parts)
 
     def surface(self) -> trimesh.Trimesh:
+        import trimesh
+
         return trimesh.util.concatenate([part.surface() for part in self.parts])
 
     def label(self) -> str:

@@ -14,9 +14,9 @@ from dataclasses import asdict
 
 import numpy as np
 
-from tumble import scenarios
+from tumble.io import ScenarioResult
 from tumble.rigid.methods import METHODS
-from tumble.scenarios._base import ScenarioResult
+from tumble.scenarios import registry
 
 FREE_BODY_SCENARIOS = ("convergence", "sphere-exact", "t-handle", "torus-spin")
 """Scenarios whose body is torque-free with an exact solution (they define ``free_body()``)."""
@@ -74,7 +74,7 @@ def run(
         raise ValueError(f"t_end={t_end!r} is not allowed: it must be finite and > 0 (s)")
     from tumble.rigid.work_precision import work_precision
 
-    body, omega0 = scenarios.get(scenario).free_body()
+    body, omega0 = registry.get(scenario).free_body()
     points = work_precision(
         body,
         t_end,

@@ -28,8 +28,8 @@ from functools import partial
 import numpy as np
 
 from tumble import exact
+from tumble.io import ScenarioResult
 from tumble.rigid import METHODS, RigidBody, simulate
-from tumble.scenarios._base import ScenarioResult
 from tumble.viz import rigid
 
 NAME = "convergence"

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from pydantic import AfterValidator, BaseModel, create_model
 
-from tumble import scenarios
+from tumble.scenarios import registry
 from tumble.scenarios.schema import (
     Flag,
     Integer,
@@ -191,11 +191,11 @@ def options_model(scenario: str) -> type[BaseModel]:
 
 
 def _scenario(name: Any):
-    if name not in scenarios.names():
+    if name not in registry.names():
         raise ValueError(
-            f"scenario = {name!r} is not known; allowed: {', '.join(scenarios.names())}"
+            f"scenario = {name!r} is not known; allowed: {', '.join(registry.names())}"
         )
-    return scenarios.get(name)
+    return registry.get(name)
 
 
 __all__ = ["METHOD_CHOICES", "MIN_DISTINCT", "POSITIVE", "THREE_VECTORS", "options_model"]

@@ -26,14 +26,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble import mass, meshes
+from tumble.io import ScenarioResult
 from tumble.rigid import Impulse, RigidBody, simulate
-from tumble.scenarios._base import (
-    ScenarioResult,
-    rigid_animations,
-    rigid_attrs,
-    rigid_datasets,
-    showcase,
-)
+from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
 from tumble.viz import rigid
 
 NAME = "prism-impulse"

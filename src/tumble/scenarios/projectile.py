@@ -6,8 +6,8 @@ from functools import partial
 
 import numpy as np
 
+from tumble.io import ScenarioResult
 from tumble.ode import solve
-from tumble.scenarios._base import ScenarioResult
 
 NAME = "projectile"
 SUMMARY = "Seed 000: a 1 kg point mass launched at 500 m/s, 45°; the impact found by an event."

@@ -11,7 +11,7 @@ body is described in its own coordinates (m):
   parallel-axis theorem (a part with neither ``density`` nor ``mass`` takes the
   composite's ``density``);
 * a mesh file: ``{"mesh": "part.stl", "density": 2700, "scale": 0.001}``
-  (:func:`tumble.mass.from_mesh`; the mesh must be closed and outward-oriented).
+  (:func:`tumble.meshes.from_mesh`; the mesh must be closed and outward-oriented).
 
 The simulated body has its centre of mass ``com`` at the origin and keeps the axes of the
 description (its inertia need not be diagonal). At ``t = 0`` the body stands where the
@@ -35,10 +35,11 @@ import numpy as np
 from pydantic import AfterValidator, Field, model_validator
 
 from tumble import so3
+from tumble.io import ScenarioResult
 from tumble.rigid import Force, Gravity, Impulse, RigidBody, Torque, Trajectory, simulate
 from tumble.rigid.initial import check_steps, initial_attitude
 from tumble.rigid.methods import METHODS, get_method
-from tumble.scenarios._base import ScenarioResult, rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
 from tumble.scenarios.bodies import Body
 from tumble.scenarios.schema import (
     Matrix3,

@@ -20,14 +20,9 @@ from functools import partial
 import numpy as np
 
 from tumble import exact, meshes
+from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, Trajectory, simulate
-from tumble.scenarios._base import (
-    ScenarioResult,
-    rigid_animations,
-    rigid_attrs,
-    rigid_datasets,
-    showcase,
-)
+from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
 from tumble.viz import rigid
 
 NAME = "sphere-exact"

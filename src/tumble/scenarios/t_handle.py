@@ -21,8 +21,9 @@ from functools import partial
 import numpy as np
 
 from tumble import exact, mass, meshes
+from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, Trajectory, simulate
-from tumble.scenarios._base import ScenarioResult, rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
 from tumble.viz import rigid
 
 NAME = "t-handle"

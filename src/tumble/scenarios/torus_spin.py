@@ -23,14 +23,9 @@ from functools import partial
 import numpy as np
 
 from tumble import exact, mass, meshes
+from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, simulate
-from tumble.scenarios._base import (
-    ScenarioResult,
-    rigid_animations,
-    rigid_attrs,
-    rigid_datasets,
-    showcase,
-)
+from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
 from tumble.viz import rigid
 
 NAME = "torus-spin"

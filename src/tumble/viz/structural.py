@@ -3,7 +3,7 @@
 Every function builds a :class:`matplotlib.figure.Figure` on the Agg canvas (matplotlib is
 imported inside the functions, never at module import, and pyplot's global state is not
 used). :func:`figure_writer` turns a figure function into the ``writer(path)`` that a
-:class:`~tumble.scenarios._base.ScenarioResult` lists; :func:`beam_frames` renders RGB
+:class:`~tumble.io.ScenarioResult` lists; :func:`beam_frames` renders RGB
 arrays for an animation and :func:`beam_animation` writes them as a GIF (or MP4).
 """
 

@@ -1,0 +1,97 @@
+"""``import tumble`` is light: the heavy dependencies load only when a name needs them.
+
+Each check runs in a fresh interpreter, since this test session has long imported them all.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import tumble
+
+HEAVY = ("numba", "trimesh", "xarray", "plotly", "matplotlib")
+SOURCE = Path(tumble.__file__).parents[1]
+
+
+def fresh(code: str) -> subprocess.CompletedProcess[str]:
+    """Run ``code`` in a new interpreter that imports this checkout's tumble."""
+    return subprocess.run(
+        [sys.executable, "-c", code],
+        cwd=SOURCE,
+        env={**os.environ, "PYTHONPATH": str(SOURCE)},
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+
+
+def heavy_modules_after(statement: str) -> list[str]:
+    result = fresh(
+        f"import json, sys\n{statement}\n"
+        f"print(json.dumps(sorted(set({HEAVY!r}) & set(sys.modules))))"
+    )
+    assert result.returncode == 0, result.stderr
+    return json.loads(result.stdout)
+
+
+@pytest.mark.parametrize(
+    "statement",
+    [
+        "import tumble",
+        "from tumble import solve",
+        "import tumble.io",
+        "import tumble.mass",
+        "import tumble.meshes",
+        "import tumble.exact",
+        "import tumble.scenarios",
+        "import tumble.cli",
+    ],
+)
+def test_import_loads_none_of_the_heavy_dependencies(statement):
+    assert heavy_modules_after(statement) == []
+
+
+def test_the_heavy_dependencies_load_when_a_name_needs_them():
+    # the check above can fail: touching a rigid-body name loads the compiled kernels
+    assert "numba" in heavy_modules_after("import tumble\ntumble.simulate_batch")
+
+
+def test_the_package_is_this_checkout():
+    result = fresh("import tumble; print(tumble.__file__)")
+    assert Path(result.stdout.strip()) == Path(tumble.__file__)
+
+
+@pytest.mark.parametrize("name", tumble.__all__)
+def test_every_public_name_resolves_to_its_module_object(name):
+    value = getattr(tumble, name)
+    origin = "tumble.ode" if name in {"ButcherTableau", "OdeResult", "solve"} else "tumble.rigid"
+    if name in {"exact", "mass", "meshes", "so3", "structural"}:
+        assert value is sys.modules[f"tumble.{name}"]
+    else:
+        assert value is getattr(sys.modules[origin], name)
+
+
+def test_dir_lists_the_names_before_they_are_imported():
+    result = fresh(
+        "import sys, tumble\n"
+        "names = dir(tumble)\n"
+        "print(all(n in names for n in tumble.__all__), 'tumble.rigid' in sys.modules)"
+    )
+    assert result.stdout.split() == ["True", "False"], result.stderr
+
+
+def test_version_is_the_installed_metadata():
+    from importlib.metadata import version
+
+    assert tumble.__version__ == version("tumble")
+
+
+def test_an_unknown_name_raises_attribute_error():
+    with pytest.raises(AttributeError, match="no attribute 'simulat'"):
+        tumble.simulat  # noqa: B018
