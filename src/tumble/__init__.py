@@ -8,6 +8,7 @@ ZYX Euler angles ``R = Rz(φ) Ry(θ) Rx(ψ)``.
 ==================================  ==========================================================
 ODE core
 :func:`solve`                       integrate ``y' = f(t, y)`` (tableaux, step control, events)
+:class:`Status`                     how a run ended: every result carries one
 :class:`ButcherTableau`             a Runge–Kutta method as data
 Rigid bodies
 :class:`RigidBody`                  mass and inertia about the centre of mass
@@ -42,7 +43,7 @@ if TYPE_CHECKING:  # what static type checkers see; at run time __getattr__ impo
     from tumble import scenarios as scenarios
     from tumble import viz as viz
     from tumble._version import __version__ as __version__
-    from tumble.ode import ButcherTableau, OdeResult, solve
+    from tumble.ode import ButcherTableau, OdeResult, Status, solve
     from tumble.rigid import (
         METHODS,
         BatchTrajectory,
@@ -60,14 +61,15 @@ if TYPE_CHECKING:  # what static type checkers see; at run time __getattr__ impo
 logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 __all__ = [
-    "METHODS",
     "BatchTrajectory",
     "ButcherTableau",
     "Force",
     "Gravity",
     "Impulse",
+    "METHODS",
     "OdeResult",
     "RigidBody",
+    "Status",
     "Torque",
     "Trajectory",
     "exact",
@@ -85,7 +87,7 @@ _SUBMODULES = frozenset(
 )
 """Modules reachable as ``tumble.<name>`` after a bare ``import tumble``."""
 _NAMES = {
-    **dict.fromkeys(["ButcherTableau", "OdeResult", "solve"], "tumble.ode"),
+    **dict.fromkeys(["ButcherTableau", "OdeResult", "Status", "solve"], "tumble.ode"),
     **dict.fromkeys(
         [
             "METHODS",
