@@ -151,7 +151,7 @@ def test_a_spin_that_overflows_between_recorded_samples_keeps_its_last_finite_st
 
 
 def test_adaptive_method_is_refused_with_the_fixed_ones_listed(body):
-    with pytest.raises(ValueError, match="rkmk45.*adaptive.*'rkmk4'"):
+    with pytest.raises(ValueError, match="method='rkmk45'.*fixed-step.*'rkmk4'.*adaptive"):
         simulate_batch(body, 1.0, method="rkmk45", h=0.1, omega0=OMEGA0)
 
 
@@ -175,14 +175,26 @@ def test_events_are_refused(body):
     [
         (
             dict(omega0=(1.0, 0.0, 0.0)),
-            r"omega0 has shape \(3,\); simulate_batch expects \(N, 3\)",
+            r"omega0.shape=\(3,\) is not allowed: must be \(N, 3\)",
         ),
-        (dict(omega0=OMEGA0, R0=R0[:2]), r"R0 has shape \(2, 3, 3\); expected \(3, 3, 3\)"),
-        (dict(omega0=OMEGA0, x0=np.zeros((3, 2))), r"x0 has shape \(3, 2\); expected \(3, 3\)"),
-        (dict(q0=np.zeros((3, 4))), r"q0\[0\] has zero norm"),
+        (
+            dict(omega0=OMEGA0, R0=R0[:2]),
+            r"R0.shape=\(2, 3, 3\) is not allowed: must be \(3, 3, 3\)",
+        ),
+        (
+            dict(omega0=OMEGA0, x0=np.zeros((3, 2))),
+            r"x0.shape=\(3, 2\) is not allowed: must be \(3, 3\)",
+        ),
+        (
+            dict(q0=np.zeros((3, 4))),
+            r"q0\[0\]=\[0.0, 0.0, 0.0, 0.0\] is not allowed: .*non-zero norm",
+        ),
         (dict(R0=2 * R0), "R0 must be a rotation matrix"),
         (dict(omega0=OMEGA0, L0=OMEGA0), "at most one of omega0"),
-        (dict(v0=[[0, 0, 0], [np.nan, 0, 0], [0, 0, 0]]), r"v0\[1\] is not finite"),
+        (
+            dict(v0=[[0, 0, 0], [np.nan, 0, 0], [0, 0, 0]]),
+            r"v0\[1\]=\[nan, 0.0, 0.0\] is not allowed: must be every entry finite",
+        ),
         (dict(omega0=OMEGA0, h=-0.1), "h=-0.1"),
         (dict(omega0=OMEGA0, record_every=0), "record_every=0"),
     ],
@@ -196,7 +208,7 @@ def test_bad_per_body_input_names_the_argument_and_shapes(body, arguments, messa
 
 def test_bodies_are_counted_and_checked(bodies):
     with pytest.raises(
-        ValueError, match=r"omega0 has shape \(2, 3\); expected \(3, 3\).*3 bodies"
+        ValueError, match=r"omega0.shape=\(2, 3\) is not allowed: must be \(3, 3\).*3 bodies"
     ):
         simulate_batch(bodies, 1.0, h=0.1, omega0=OMEGA0[:2])
     with pytest.raises(ValueError, match=r"body_or_bodies\[1\]"):

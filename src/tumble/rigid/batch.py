@@ -213,13 +213,12 @@ def _bodies(body_or_bodies) -> tuple[list[RigidBody], bool]:
     if isinstance(body_or_bodies, RigidBody):
         return [body_or_bodies], True
     if not isinstance(body_or_bodies, Sequence) or len(body_or_bodies) == 0:
-        raise ValueError(
-            f"body_or_bodies={body_or_bodies!r} must be a tumble.RigidBody or a non-empty "
-            "sequence of them"
+        raise _checks.fail(
+            "body_or_bodies", body_or_bodies, "a tumble.RigidBody or a non-empty sequence of them"
         )
     for index, body in enumerate(body_or_bodies):
         if not isinstance(body, RigidBody):
-            raise ValueError(f"body_or_bodies[{index}]={body!r} must be a tumble.RigidBody")
+            raise _checks.fail(f"body_or_bodies[{index}]", body, "a tumble.RigidBody")
     return list(body_or_bodies), False
 
 
@@ -235,9 +234,8 @@ def _batch_size(bodies, one_body: bool, arrays: dict) -> tuple[int, str]:
             shape = np.shape(value)
             if len(shape) != 1 + len(_ROW_SHAPES[name]) or shape[0] == 0:
                 expected = ", ".join(["N", *map(str, _ROW_SHAPES[name])])
-                raise ValueError(
-                    f"{name} has shape {shape}; simulate_batch expects ({expected}), one row "
-                    "per body (N ≥ 1)"
+                raise _checks.fail(
+                    f"{name}.shape", shape, f"({expected}): one row per body (N ≥ 1)"
                 )
             return shape[0], f"the first axis of {name}"
     return 1, "one body and no per-body arrays"
@@ -250,13 +248,14 @@ def _rows(value, name: str, n: int, source: str) -> np.ndarray | None:
     array = np.asarray(value, dtype=float)
     expected = (n, *_ROW_SHAPES[name])
     if array.shape != expected:
-        raise ValueError(
-            f"{name} has shape {array.shape}; expected {expected}: one row per body "
-            f"(N = {n}, from {source})"
-        )
+        raise _checks.fail(
+            f"{name}.shape", array.shape, f"{expected}: one row per body",
+            remedy=f"N = {n}, from {source}",
+        )  # fmt: skip
     bad = ~np.isfinite(array.reshape(n, -1)).all(axis=1)
     if bad.any():
-        raise ValueError(f"{name}[{int(np.argmax(bad))}] is not finite: {array[bad][0]!r}")
+        index = int(np.argmax(bad))
+        raise _checks.fail(f"{name}[{index}]", array[index].tolist(), "every entry finite")
     return array
 
 
@@ -272,8 +271,9 @@ def _initial_states(bodies, R0, q0, omega0, L0, x0, v0, n: int):
     if q0 is not None:
         norm = np.linalg.norm(q0, axis=-1)
         if np.any(norm == 0):
-            raise ValueError(
-                f"q0[{int(np.argmin(norm))}] has zero norm; a quaternion [w, x, y, z]"
+            index = int(np.argmin(norm))
+            raise _checks.fail(
+                f"q0[{index}]", q0[index].tolist(), "a quaternion [w, x, y, z] of non-zero norm"
             )
         R = so3.matrix_from_quat(q0 / norm[:, None])
     elif R0 is not None:
@@ -296,11 +296,12 @@ def _kernel_loads(forces, bodies):
     """``(F (N, 3), tau, points, point_forces)`` for the constant loads; else a ValueError."""
     loads, impulses = split_loads(forces)
     if impulses or not all(load.compiled for load in loads):
-        raise ValueError(
-            "simulate_batch supports constant loads only: tumble.Gravity, and tumble.Force and "
-            "tumble.Torque with constant vectors; impulses and callable forces need "
-            "tumble.simulate (one body per call)"
-        )
+        raise _checks.fail(
+            "forces", forces,
+            "constant loads only: tumble.Gravity, and tumble.Force and tumble.Torque with "
+            "constant vectors",
+            remedy="impulses and callable forces need tumble.simulate (one body per call)",
+        )  # fmt: skip
     F = _per_body(bodies, lambda body: compiled_loads(loads, body.mass)[0]).copy()
     _, tau, points, point_forces = compiled_loads(loads, bodies[0].mass)
     return F, tau, points, point_forces
@@ -402,15 +403,17 @@ def simulate_batch(
     """
     spec = get_method(method)
     if spec.adaptive:
-        raise ValueError(
-            f"method={method!r} is adaptive; simulate_batch runs the fixed-step methods "
-            f"{FIXED_METHODS} (use simulate for {method!r})"
-        )
+        raise _checks.fail(
+            "method", method, "a fixed-step method, one of " + ", ".join(map(repr, FIXED_METHODS)),
+            remedy=f"{method!r} is adaptive: use tumble.simulate for it",
+        )  # fmt: skip
     t0, t_end = initial.check_times(t0, t_end)
     h, _, _ = initial.check_steps(spec, h, None, None)
     every = _checks.count("record_every", record_every)
     if list(events):
-        raise ValueError("simulate_batch does not locate events; use tumble.simulate for events")
+        raise _checks.fail(
+            "events", events, "empty", remedy="simulate_batch locates no events: use simulate"
+        )
     bodies, one_body = _bodies(body_or_bodies)
     arrays = {"omega0": omega0, "L0": L0, "R0": R0, "q0": q0, "x0": x0, "v0": v0}
     n_bodies, source = _batch_size(bodies, one_body, arrays)
