@@ -48,34 +48,42 @@ def fail(name: str, value: object, allowed: str, unit: str = "", remedy: str = "
     return ValueError(message)
 
 
-def _real(value: object) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+def _finite_real(value: object) -> float | None:
+    """``value`` as a float if it is a finite real number (not a bool), else None."""
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        number = float(value)
+        if math.isfinite(number):
+            return number
+    return None
 
 
 def positive(name: str, value: object, unit: str = "", remedy: str = "") -> float:
     """``value`` as a float, after checking it is a finite real number > 0."""
-    if not (_real(value) and math.isfinite(value) and value > 0):  # type: ignore[arg-type]
+    number = _finite_real(value)
+    if number is None or not number > 0:
         raise fail(name, value, "finite and > 0", unit, remedy)
-    return float(value)  # type: ignore[arg-type]
+    return number
 
 
 def non_negative(name: str, value: object, unit: str = "", remedy: str = "") -> float:
     """``value`` as a float, after checking it is a finite real number >= 0."""
-    if not (_real(value) and math.isfinite(value) and value >= 0):  # type: ignore[arg-type]
+    number = _finite_real(value)
+    if number is None or not number >= 0:
         raise fail(name, value, "finite and >= 0", unit, remedy)
-    return float(value)  # type: ignore[arg-type]
+    return number
 
 
 def finite(name: str, value: object, unit: str = "", remedy: str = "") -> float:
     """``value`` as a float, after checking it is a finite real number."""
-    if not (_real(value) and math.isfinite(value)):  # type: ignore[arg-type]
+    number = _finite_real(value)
+    if number is None:
         raise fail(name, value, "a finite number", unit, remedy)
-    return float(value)  # type: ignore[arg-type]
+    return number
 
 
 def count(name: str, value: object, minimum: int = 1) -> int:
     """``value`` as an int, after checking it is an integer ``>= minimum`` (bools refused)."""
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < minimum:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or int(value) < minimum:
         raise fail(name, value, f"an integer >= {minimum}")
     return int(value)
 

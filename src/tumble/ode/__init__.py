@@ -16,7 +16,7 @@
 from tumble.ode.control import StepController, error_norm
 from tumble.ode.dense import DenseOutput
 from tumble.ode.driver import Status, Stepper, march
-from tumble.ode.solve import OdeResult, solve
+from tumble.ode.ivp import OdeResult, solve
 from tumble.ode.stepper import rk_step
 from tumble.ode.tableaux import TABLEAUX, ButcherTableau
 

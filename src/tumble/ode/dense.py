@@ -13,6 +13,8 @@ f_{n+1})``.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
+
 import numpy as np
 
 from tumble.ode.tableaux import ButcherTableau
@@ -64,25 +66,27 @@ class StepInterpolant:
 class DenseOutput:
     """The continuous solution over the whole run, like scipy's ``OdeSolution``.
 
-    Parameters
-    ----------
-    ts : ndarray, shape (m + 1,)
-        Step boundaries, increasing.
-    interpolants : list of StepInterpolant
-        One per step.
+        Parameters
+        ----------
+        ts : ndarray, shape (m + 1,)
+            Step boundaries, increasing.
+        interpolants : list of StepInterpolant
+            One per step.
 
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from tumble import solve
-    >>> result = solve(lambda t, y: -y, (0.0, 1.0), [1.0], method="dopri5", dense_output=True)
-    >>> bool(abs(result.sol(0.5)[0] - np.exp(-0.5)) < 1e-6)
-    True
+        Examples
+        --------
+        >>> from collections.abc import Callable, Sequence
+
+    import numpy as np
+        >>> from tumble import solve
+        >>> result = solve(lambda t, y: -y, (0.0, 1.0), [1.0], method="dopri5", dense_output=True)
+        >>> bool(abs(result.sol(0.5)[0] - np.exp(-0.5)) < 1e-6)
+        True
     """
 
-    def __init__(self, ts: np.ndarray, interpolants: list[StepInterpolant]):
+    def __init__(self, ts: Sequence[float] | np.ndarray, interpolants: Sequence[Callable]):
         self.ts = np.asarray(ts, dtype=float)
-        self.interpolants = interpolants
+        self.interpolants = list(interpolants)
         self.t_min, self.t_max = float(self.ts[0]), float(self.ts[-1])
 
     def __call__(self, t: float | np.ndarray) -> np.ndarray:

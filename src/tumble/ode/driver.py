@@ -67,6 +67,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from tumble import _checks
 from tumble.ode.control import (
     StepController,
     error_norm,
@@ -291,17 +292,17 @@ class _Run:
         """Take an accepted step; True when the run must stop (a terminal event)."""
         stepper = self.stepper
         stepper.accept(t_new, new)
-        sol = None
         if self.tracker is not None or self.interpolants is not None:
             sol = stepper.interpolant(t_old, old, t_new, new)
-        if self.tracker is not None:
-            t_stop = self.tracker.update(t_old, t_new, new, sol)
-            if t_stop is not None:
-                t_new, new = t_stop, sol(t_stop)
-                self.status, self.message = Status.TERMINAL_EVENT, Status.TERMINAL_EVENT.message
-        if self.interpolants is not None:
-            self.interpolants.append(sol)
-            self.step_times.append(t_new)
+            if self.tracker is not None:
+                t_stop = self.tracker.update(t_old, t_new, new, sol)
+                if t_stop is not None:
+                    t_new, new = t_stop, sol(t_stop)
+                    self.status = Status.TERMINAL_EVENT
+                    self.message = Status.TERMINAL_EVENT.message
+            if self.interpolants is not None and self.step_times is not None:
+                self.interpolants.append(sol)
+                self.step_times.append(t_new)
         self.t, self.state = t_new, new
         self.n_steps += 1
         if self.n_steps % self.every == 0:
@@ -473,6 +474,7 @@ def march(
     ([0.0, 0.5, 1.0], [1.0, 0.5625, 0.31640625], <Status.SUCCESS: 0>)
     """
     t0, t1 = t_span
+    step = _checks.positive("h", h)  # the caller chose it (a first step when adaptive)
     limit = math.inf if max_steps is None else max_steps
     run = _Run(stepper, t0, state, list(events), record_every, limit, dense_output, progress)
     compiled = stepper.blocks and control is None and not events and not dense_output
@@ -480,11 +482,11 @@ def march(
     for end, applied in _segments(t0, t1, jumps):
         if run.t < end:
             if control is not None:
-                going, h = _adaptive(run, end, h, control)
+                going, step = _adaptive(run, end, step, control)
             elif compiled:
-                going = _blocks(run, end, h)
+                going = _blocks(run, end, step)
             else:
-                going = _fixed(run, end, h)
+                going = _fixed(run, end, step)
         if not going:
             break
         for apply in applied:

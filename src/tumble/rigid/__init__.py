@@ -14,7 +14,7 @@ from tumble.rigid.batch import BatchTrajectory, simulate_batch
 from tumble.rigid.body import RigidBody
 from tumble.rigid.forces import Force, Gravity, Impulse, State, Torque
 from tumble.rigid.methods import METHODS, Method
-from tumble.rigid.simulate import simulate
+from tumble.rigid.simulation import simulate
 from tumble.rigid.trajectory import Trajectory
 
 __all__ = [

@@ -23,8 +23,9 @@ from __future__ import annotations
 
 import math
 import types
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numba import njit, prange
@@ -33,8 +34,8 @@ SERIES_ANGLE = 0.25
 """Below this angle (rad) the exp and dexp⁻¹ coefficients use their Taylor series; the first
 term left out is below 1e-17 relative (θ¹²/13! for sin θ/θ, 8e-19 for dexp⁻¹)."""
 
-_JIT = dict(cache=True, error_model="numpy")  # numpy error model: no ZeroDivisionError checks
-_INLINE = dict(_JIT, inline="always")
+_JIT: dict[str, Any] = dict(cache=True, error_model="numpy")  # no ZeroDivisionError checks
+_INLINE: dict[str, Any] = dict(_JIT, inline="always")
 _SERIES2 = SERIES_ANGLE * SERIES_ANGLE
 _S1, _S2, _S3, _S4, _S5 = -1.0 / 6, 1.0 / 120, -1.0 / 5040, 1.0 / 362880, -1.0 / 39916800
 _C1, _C2, _C3, _C4, _C5 = -1.0 / 24, 1.0 / 720, -1.0 / 40320, 1.0 / 3628800, -1.0 / 479001600
@@ -243,7 +244,7 @@ class Problem(NamedTuple):
     A: np.ndarray
     b: np.ndarray
     inv_I: np.ndarray
-    m: float
+    m: float | np.ndarray
     F: np.ndarray
     tau: np.ndarray
     points: np.ndarray
@@ -338,10 +339,10 @@ def _bind(template, name: str, **functions):
 
 @dataclass(frozen=True)
 class CompiledChart:
-    """A chart's compiled loop for one body and for a batch."""
+    """A chart's compiled loop for one body (:func:`_loop`) and for a batch (:func:`_batch`)."""
 
-    loop: object
-    batch: object
+    loop: Callable[..., tuple[int, int]]
+    batch: Callable[..., None]
 
 
 def _for_chart(name: str, field, advance, record) -> CompiledChart:

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from tumble.exact import free_body_rotation
 from tumble.rigid.body import RigidBody
 from tumble.rigid.methods import get_method
-from tumble.rigid.simulate import simulate
+from tumble.rigid.simulation import simulate
 
 STEPS = (50, 100, 200, 400, 800)
 """Default step counts of the fixed-step methods over ``[0, t_end]``."""

@@ -236,7 +236,9 @@ def solve(
                     max_steps=int(max_steps), dense_output=dense_output)  # fmt: skip
     t_events = [np.array(ts, dtype=float) for ts in out.t_events]
     y_events = [np.array(ys, dtype=float).reshape(-1, y.size) for ys in out.y_events]
-    sol = DenseOutput(out.step_times, out.interpolants) if out.interpolants else None
+    sol = None
+    if out.step_times is not None and out.interpolants:
+        sol = DenseOutput(out.step_times, out.interpolants)
     return OdeResult(
         t=out.t,
         y=out.records[0].T,
