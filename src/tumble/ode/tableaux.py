@@ -18,10 +18,15 @@ and, for an embedded pair, the error estimate is :math:`h \\sum_i (b_i - \\hat b
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 _TOL = 1e-14
+
+
+Coefficients = Any
+"""array_like when a tableau is written, a read-only float ndarray once it is constructed."""
 
 
 def _frozen(values, ndim: int) -> np.ndarray:
@@ -73,14 +78,14 @@ class ButcherTableau:
     """
 
     name: str
-    c: np.ndarray
-    A: np.ndarray
-    b: np.ndarray
+    c: Coefficients
+    A: Coefficients
+    b: Coefficients
     order: int
-    b_hat: np.ndarray | None = None
+    b_hat: Coefficients | None = None
     order_hat: int | None = None
     fsal: bool = False
-    dense: np.ndarray | None = None
+    dense: Coefficients | None = None
     reference: str = ""
     e: np.ndarray | None = field(init=False, default=None)
     rows: tuple = field(init=False, default=(), repr=False)

@@ -10,11 +10,12 @@ to one body).
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import _checks, so3
 from tumble.ode.control import fixed_step_count
@@ -22,7 +23,7 @@ from tumble.ode.driver import Block, Grid, Status, Stepper, march, non_finite_me
 from tumble.rigid import initial
 from tumble.rigid.body import RigidBody
 from tumble.rigid.charts import CHARTS
-from tumble.rigid.forces import compiled_loads, split_loads
+from tumble.rigid.forces import Impulse, Load, State, compiled_loads, split_loads
 from tumble.rigid.methods import METHODS, Method, get_method
 from tumble.rigid.trajectory import Trajectory
 
@@ -321,14 +322,14 @@ def simulate_batch(
     method: str = "rkmk4",
     h: float | None = None,
     t0: float = 0.0,
-    x0=None,
-    v0=None,
-    R0=None,
-    q0=None,
-    omega0=None,
-    L0=None,
-    forces=(),
-    events=(),
+    x0: ArrayLike | None = None,
+    v0: ArrayLike | None = None,
+    R0: ArrayLike | None = None,
+    q0: ArrayLike | None = None,
+    omega0: ArrayLike | None = None,
+    L0: ArrayLike | None = None,
+    forces: Sequence[Load | Impulse] = (),
+    events: Sequence[Callable[[float, State], float]] = (),
     record_every: int = 1,
 ) -> BatchTrajectory:
     """Simulate ``N`` rigid bodies from ``t0`` to ``t_end`` in one compiled, parallel call.

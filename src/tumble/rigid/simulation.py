@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import _checks
 from tumble._progress import progress_bar
@@ -13,7 +15,7 @@ from tumble.ode.driver import Control, Jump, march
 from tumble.rigid import initial
 from tumble.rigid.body import RigidBody
 from tumble.rigid.charts import Dynamics
-from tumble.rigid.forces import compiled_loads, split_loads
+from tumble.rigid.forces import Impulse, Load, State, compiled_loads, split_loads
 from tumble.rigid.methods import Method, get_method
 from tumble.rigid.steppers import CompiledStepper, RigidStepper
 from tumble.rigid.trajectory import Trajectory
@@ -53,14 +55,14 @@ def simulate(
     rtol: float | None = None,
     atol: float | None = None,
     t0: float = 0.0,
-    x0=None,
-    v0=None,
-    R0=None,
-    q0=None,
-    omega0=None,
-    L0=None,
-    forces=(),
-    events=(),
+    x0: ArrayLike | None = None,
+    v0: ArrayLike | None = None,
+    R0: ArrayLike | None = None,
+    q0: ArrayLike | None = None,
+    omega0: ArrayLike | None = None,
+    L0: ArrayLike | None = None,
+    forces: Sequence[Load | Impulse] = (),
+    events: Sequence[Callable[[float, State], float]] = (),
     progress: bool = False,
     record_every: int = 1,
     compiled: bool | None = None,
