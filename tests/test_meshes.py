@@ -145,7 +145,10 @@ def test_load_refuses_an_unparsable_file(tmp_path):
         (lambda: meshes.cylinder(1.0, 1.0, axis="q"), r'axis must be "x"'),
         (lambda: meshes.hex_prism(1.0, -3.0), r"length must be .*> 0; got -3\.0"),
         (lambda: meshes.box([1.0, 0.0, 1.0]), r"extents must be .*> 0"),
-        (lambda: meshes.box([1.0, 1.0, 1.0], rotation=np.ones((3, 3))), r"rotation must be"),
+        (
+            lambda: meshes.box([1.0, 1.0, 1.0], rotation=np.ones((3, 3))),
+            r"rotation=.* is not allowed: must be a rotation matrix",
+        ),
         (lambda: meshes.sphere(1.0, -1), r"subdivisions must be an integer >= 0; got -1"),
         (lambda: meshes.sphere(-1.0), r"radius must be .*> 0; got -1\.0"),
     ],

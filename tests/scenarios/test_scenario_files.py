@@ -261,7 +261,8 @@ BAD_FILES = {
     ),
     "R0 not a rotation": (
         RIGID + CYLINDER + "[options.initial]\nR0 = [[1.0, 0, 0], [0, 1.0, 0], [0, 0, -1.0]]\n",
-        "options.initial: R0 must be a rotation matrix",
+        "options.initial: R0=[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]] is not allowed: "
+        "must be a rotation matrix",
     ),
     "zero quaternion": (
         RIGID + CYLINDER + "[options.initial]\nq0 = [0.0, 0.0, 0.0, 0.0]\n",
