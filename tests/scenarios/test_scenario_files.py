@@ -243,7 +243,7 @@ BAD_FILES = {
     "torus radii": (
         RIGID + '[options.body]\nshape = "torus"\nmajor_radius = 1.0\nminor_radius = 2.0\n'
         "density = 1.0\n",
-        "options.body: minor_radius must be less than major_radius",
+        "options.body: minor_radius=2.0 is not allowed: must be less than major_radius=1.0",
     ),
     "mesh file not found": (
         RIGID + '[options.body]\nmesh = "missing.stl"\ndensity = 1000.0\n',
