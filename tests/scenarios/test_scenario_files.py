@@ -292,7 +292,8 @@ BAD_FILES = {
     ),
     "tolerance for a fixed step": (
         RIGID + "[options]\nrtol = 1e-6\n" + CYLINDER,
-        "options: rtol=1e-06, atol=None: tolerances apply only to method='rkmk45'",
+        "options: rtol=1e-06 is not allowed: must be None for the fixed-step method 'rkmk4'; "
+        "tolerances apply only to method='rkmk45'",
     ),
 }
 
