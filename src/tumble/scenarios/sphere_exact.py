@@ -19,7 +19,7 @@ from functools import partial
 
 import numpy as np
 
-from tumble import exact, meshes
+from tumble import _checks, exact, meshes
 from tumble.rigid import RigidBody, Trajectory, simulate
 from tumble.scenarios._base import (
     ScenarioResult,
@@ -46,7 +46,7 @@ SEED_EULER_AT_1 = np.array(
 def _methods(methods: Sequence[str] | str) -> tuple[str, ...]:
     methods = (methods,) if isinstance(methods, str) else tuple(methods)
     if not methods:
-        raise ValueError("methods=() is not allowed: name at least one method")
+        raise _checks.fail("methods", methods, "at least one method name")
     return methods
 
 
