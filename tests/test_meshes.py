@@ -99,55 +99,81 @@ def test_save_writes_nothing_when_the_export_fails(tmp_path, monkeypatch):
 
 
 def test_save_refuses_an_unknown_extension(tmp_path):
-    with pytest.raises(ValueError, match=r"path must end in one of \.glb, .*\.stl; got .*\.dwg"):
+    with pytest.raises(
+        ValueError,
+        match=r"path=.*\.dwg' is not allowed: must be a file name ending in one of \.glb, .*\.stl",
+    ):
         meshes.save(meshes.box([1.0, 1.0, 1.0]), tmp_path / "cube.dwg")
 
 
 def test_save_refuses_a_missing_folder(tmp_path):
-    with pytest.raises(ValueError, match=r"path must be in an existing folder; got .*nowhere"):
+    with pytest.raises(
+        ValueError, match=r"path=.*nowhere.* is not allowed: must be a file in an existing folder"
+    ):
         meshes.save(meshes.box([1.0, 1.0, 1.0]), tmp_path / "nowhere" / "cube.stl")
 
 
 def test_load_refuses_a_missing_file(tmp_path):
-    with pytest.raises(ValueError, match=r"path must be an existing mesh file; got .*absent\.stl"):
+    with pytest.raises(
+        ValueError, match=r"path=.*absent\.stl' is not allowed: must be an existing mesh file"
+    ):
         meshes.load(tmp_path / "absent.stl")
 
 
 def test_load_refuses_an_unknown_extension(tmp_path):
     path = tmp_path / "drawing.dwg"
     path.write_text("x")
-    with pytest.raises(ValueError, match=r"path must end in one of .*\.stl; got .*drawing\.dwg"):
+    with pytest.raises(
+        ValueError,
+        match=r"path=.*drawing\.dwg' is not allowed: must be a file name ending in one of .*stl",
+    ):
         meshes.load(path)
 
 
 def test_load_refuses_a_file_without_triangles(tmp_path):
     path = tmp_path / "garbage.stl"
     path.write_bytes(b"\x00garbage")
-    with pytest.raises(ValueError, match=r"path must be a mesh file with triangles; .*garbage"):
+    with pytest.raises(
+        ValueError, match=r"path=.*garbage.* is not allowed: must be a mesh file with triangles"
+    ):
         meshes.load(path)
 
 
 def test_load_refuses_an_unparsable_file(tmp_path):
     path = tmp_path / "broken.glb"
     path.write_bytes(b"glTF this is not binary gltf")
-    with pytest.raises(ValueError, match=r"path must be a readable glb mesh file; .*broken"):
+    with pytest.raises(
+        ValueError, match=r"path=.*broken.* is not allowed: must be a readable glb mesh file"
+    ):
         meshes.load(path)
 
 
 @pytest.mark.parametrize(
     ("build", "message"),
     [
-        (lambda: meshes.torus(1.0, 1.5), r"minor_radius must be less than major_radius"),
-        (lambda: meshes.torus(-1.0, 0.5), r"major_radius must be .*> 0; got -1\.0"),
-        (lambda: meshes.torus(1.0, 0.5, 2), r"sections must be an integer >= 3; got 2"),
-        (lambda: meshes.torus(1.0, 0.5, minor_sections=2.5), r"minor_sections must be an int"),
-        (lambda: meshes.cylinder(0.0, 1.0), r"radius must be .*> 0; got 0\.0"),
-        (lambda: meshes.cylinder(1.0, 1.0, axis="q"), r'axis must be "x"'),
-        (lambda: meshes.hex_prism(1.0, -3.0), r"length must be .*> 0; got -3\.0"),
-        (lambda: meshes.box([1.0, 0.0, 1.0]), r"extents must be .*> 0"),
-        (lambda: meshes.box([1.0, 1.0, 1.0], rotation=np.ones((3, 3))), r"rotation must be"),
-        (lambda: meshes.sphere(1.0, -1), r"subdivisions must be an integer >= 0; got -1"),
-        (lambda: meshes.sphere(-1.0), r"radius must be .*> 0; got -1\.0"),
+        (
+            lambda: meshes.torus(1.0, 1.5),
+            r"minor_radius=1\.5 is not allowed: must be less than major_radius",
+        ),
+        (lambda: meshes.torus(-1.0, 0.5), r"major_radius=-1\.0 is not allowed: must be .*> 0"),
+        (lambda: meshes.torus(1.0, 0.5, 2), r"sections=2 is not allowed: must be an integer >= 3"),
+        (
+            lambda: meshes.torus(1.0, 0.5, minor_sections=2.5),
+            r"minor_sections=2\.5 is not allowed: must be an int",
+        ),
+        (lambda: meshes.cylinder(0.0, 1.0), r"radius=0\.0 is not allowed: must be .*> 0"),
+        (lambda: meshes.cylinder(1.0, 1.0, axis="q"), r'axis=\'q\' is not allowed: must be "x"'),
+        (lambda: meshes.hex_prism(1.0, -3.0), r"length=-3\.0 is not allowed: must be .*> 0"),
+        (lambda: meshes.box([1.0, 0.0, 1.0]), r"extents\[1\]=0\.0 is not allowed: must be .*> 0"),
+        (
+            lambda: meshes.box([1.0, 1.0, 1.0], rotation=np.ones((3, 3))),
+            r"rotation=.* is not allowed: must be a rotation matrix",
+        ),
+        (
+            lambda: meshes.sphere(1.0, -1),
+            r"subdivisions=-1 is not allowed: must be an integer >= 0",
+        ),
+        (lambda: meshes.sphere(-1.0), r"radius=-1\.0 is not allowed: must be .*> 0"),
     ],
     ids=[
         "torus-minor-above-major",
@@ -169,5 +195,7 @@ def test_mesh_generators_refuse_bad_input(build, message):
 
 
 def test_save_refuses_a_non_mesh(tmp_path):
-    with pytest.raises(ValueError, match=r"mesh must be a trimesh.Trimesh with faces; got 'x'"):
+    with pytest.raises(
+        ValueError, match=r"mesh='x' is not allowed: must be a trimesh.Trimesh with faces"
+    ):
         meshes.save("x", tmp_path / "x.stl")

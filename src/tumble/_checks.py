@@ -140,3 +140,43 @@ def array(
         label = f"{name}[{', '.join(map(str, index))}]"
         raise fail(label, float(result[index]), wanted.replace("every entry ", ""), unit)
     return result
+
+
+def values(
+    name: str,
+    value: ArrayLike,
+    *,
+    minimum: int = 1,
+    unit: str = "",
+    positive: bool = False,
+    remedy: str = "",
+) -> NDArray[np.float64]:
+    """``value`` as a 1-D float array (a copy) of at least ``minimum`` entries, each finite
+    (and > 0 if ``positive``): step sizes, tolerances, errors, time steps to sweep.
+
+    The message names the first bad entry.
+
+    Examples
+    --------
+    >>> values("h", [0.1], minimum=2, unit="s")
+    Traceback (most recent call last):
+    ...
+    ValueError: h=[0.1] is not allowed: must be a 1-D array of >= 2 entries, each finite (s)
+    >>> values("errors", [1e-3, 0.0], positive=True, remedy="an exact method has no order")
+    Traceback (most recent call last):
+    ...
+    ValueError: errors[1]=0.0 is not allowed: must be finite and > 0; an exact method has no order
+    """
+    each = "finite and > 0" if positive else "finite"
+    wanted = f"a 1-D array of >= {minimum} entries, each {each}"
+    try:
+        result = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise fail(name, value, wanted, unit, remedy) from None
+    if result.ndim != 1 or result.size < minimum:
+        raise fail(name, value, wanted, unit, remedy)
+    good = np.isfinite(result) & (result > 0) if positive else np.isfinite(result)
+    if not np.all(good):
+        index = int(np.argmin(good))
+        raise fail(f"{name}[{index}]", float(result[index]), each, unit, remedy)
+    return result

@@ -25,6 +25,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.special import elliprf, elliprj
 
+from tumble import _checks
+
 #: The arithmetic–geometric mean stops when ``c_n ≤ AGM_TOL * a_n`` (one ulp: a and b can
 #: settle on neighbouring floats) or after AGM_MAX_STEPS (m1 = 1e-300 needs about 15).
 AGM_TOL = float(np.finfo(float).eps)
@@ -217,11 +219,11 @@ def classify(
     if motion is None:
         if for_period:
             return "separatrix", None
-        raise ValueError(
-            f"omega0={omega0.tolist()} lies on the separatrix |L|^2 = 2 E I_mid of inertia "
-            f"moments {moments.tolist()}: the body approaches the middle axis forever and the "
-            "period is infinite; perturb omega0 off the separatrix"
-        )
+        raise _checks.fail(
+            "omega0", omega0.tolist(), "off the separatrix |L|^2 = 2 E I_mid",
+            remedy=f"with inertia moments {moments.tolist()} the body approaches the middle "
+            "axis forever and the period is infinite; perturb omega0",
+        )  # fmt: skip
     return "elliptic", motion
 
 
@@ -312,11 +314,11 @@ def principal_axes(inertia: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
         moments, axes = diagonal[order], np.eye(3)[:, order]
     elif I.shape == (3, 3):
         if not np.all(np.isfinite(I)) or np.abs(I - I.T).max() > SYMMETRIC_RTOL * np.abs(I).max():
-            raise ValueError(f"inertia={I.tolist()} must be a finite symmetric 3x3 matrix")
+            raise _checks.fail("inertia", I.tolist(), "a finite symmetric 3x3 matrix", "kg m^2")
         moments, axes = np.linalg.eigh(0.5 * (I + I.T))
         check_moments(moments, inertia)
     else:
-        raise ValueError(f"inertia has shape {I.shape}; pass 3 moments or a 3x3 tensor, kg m^2")
+        raise _checks.fail("inertia.shape", I.shape, "(3,) moments or a (3, 3) tensor")
     if np.linalg.det(axes) < 0:
         axes[:, 0] = -axes[:, 0]
     return moments, axes
@@ -325,10 +327,10 @@ def principal_axes(inertia: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
 def check_moments(moments: np.ndarray, inertia: ArrayLike) -> None:
     """ValueError naming `inertia` unless every principal moment is finite and > 0."""
     if not (np.all(np.isfinite(moments)) and np.all(moments > 0)):
-        raise ValueError(
-            f"inertia={np.asarray(inertia).tolist()} has principal moments {moments.tolist()}; "
-            "all must be finite and > 0 (kg m^2)"
-        )
+        raise _checks.fail(
+            "inertia", np.asarray(inertia).tolist(),
+            f"principal moments all finite and > 0 (these are {moments.tolist()})", "kg m^2",
+        )  # fmt: skip
 
 
 def check_rotation(name: str, value: ArrayLike | None) -> np.ndarray:
@@ -337,10 +339,7 @@ def check_rotation(name: str, value: ArrayLike | None) -> np.ndarray:
         return np.eye(3)
     R = np.asarray(value, dtype=float)
     if R.shape != (3, 3) or not np.all(np.isfinite(R)):
-        raise ValueError(
-            f"{name}={np.array2string(R, precision=6)} must be a finite 3x3 rotation matrix"
-        )
+        raise _checks.fail(name, R.tolist(), "a finite 3x3 rotation matrix")
     if np.abs(R.T @ R - np.eye(3)).max() > ROTATION_ATOL or np.linalg.det(R) < 0:
-        shown = np.array2string(R, precision=6)
-        raise ValueError(f"{name}={shown} is not a rotation: need R^T R = I and det R = +1")
+        raise _checks.fail(name, R.round(6).tolist(), "a rotation: R^T R = I and det R = +1")
     return R

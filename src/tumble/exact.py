@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tumble import _checks
 from tumble._elliptic import (
     body_omega,
     body_period,
@@ -54,11 +55,12 @@ class Projectile:
     y0: float = 0.0
 
     def __post_init__(self) -> None:
-        _scalar("v0", self.v0, self.v0 >= 0, "a speed >= 0 in m/s")
-        _scalar("angle", self.angle, abs(self.angle) <= np.pi / 2, "radians in [-pi/2, pi/2]")
-        _scalar("g", self.g, self.g > 0, "an acceleration > 0 in m/s^2")
-        _scalar("x0", self.x0, True, "a finite position in m")
-        _scalar("y0", self.y0, self.y0 >= 0, "a height >= 0 in m (the ground is y = 0)")
+        _checks.non_negative("v0", self.v0, "m/s")
+        if abs(_checks.finite("angle", self.angle, "rad")) > np.pi / 2:
+            raise _checks.fail("angle", self.angle, "in [-pi/2, pi/2]", "rad")
+        _checks.positive("g", self.g, "m/s²")
+        _checks.finite("x0", self.x0, "m")
+        _checks.non_negative("y0", self.y0, "m", "the ground is y = 0")
 
     @property
     def flight_time(self) -> float:
@@ -323,12 +325,14 @@ def observed_order(step_sizes: ArrayLike, errors: ArrayLike) -> float:
     >>> round(observed_order([0.1, 0.05, 0.025], [1e-4, 6.25e-6, 3.90625e-7]), 12)
     4.0
     """
-    h = _positive_array("step_sizes", step_sizes)
-    e = _positive_array("errors", errors, remedy=" (an exact method has no observed order)")
+    h = _checks.values("step_sizes", step_sizes, minimum=2, unit="s", positive=True)
+    e = _checks.values(
+        "errors", errors, minimum=2, positive=True, remedy="an exact method has no observed order"
+    )
     if e.shape != h.shape:
-        raise ValueError(f"errors has {e.size} values but step_sizes has {h.size}; pass one each")
+        raise _checks.fail("errors", errors, f"one value per step size ({h.size})")
     if np.unique(h).size < 2:
-        raise ValueError(f"step_sizes={_show(h)} must hold at least two distinct values")
+        raise _checks.fail("step_sizes", step_sizes, "at least two distinct values", "s")
     return float(np.polyfit(np.log(h), np.log(e), 1)[0])
 
 
@@ -358,16 +362,16 @@ def measure_order(
     >>> round(order, 12)
     2.0
     """
-    h = _positive_array("step_sizes", step_sizes)
+    h = _checks.values("step_sizes", step_sizes, minimum=2, unit="s", positive=True)
     errors = np.array([float(run(float(step))) for step in h])
     return observed_order(h, errors), errors
 
 
 def _times(t: ArrayLike) -> tuple[np.ndarray, bool]:
     """Times as a 1-D float array, and whether a scalar was given."""
-    arr = np.asarray(t, dtype=float)
-    if arr.ndim > 1 or not np.all(np.isfinite(arr)):
-        raise ValueError(f"t={_show(arr)} must be a finite scalar or a 1-D array of times in s")
+    arr = _checks.array("t", t, unit="s")
+    if arr.ndim > 1:
+        raise _checks.fail("t", t, "a number or a 1-D array of times", "s")
     return arr.reshape(-1), arr.ndim == 0
 
 
@@ -376,24 +380,4 @@ def _shaped(out: np.ndarray, scalar: bool) -> np.ndarray:
 
 
 def _vector(name: str, value: ArrayLike) -> np.ndarray:
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise ValueError(f"{name}={_show(arr)} must be 3 finite components in rad/s")
-    return arr
-
-
-def _positive_array(name: str, value: ArrayLike, remedy: str = "") -> np.ndarray:
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim != 1 or arr.size < 2 or not np.all(np.isfinite(arr)) or np.any(arr <= 0):
-        raise ValueError(f"{name}={_show(arr)} must be 1-D, >= 2 finite values > 0{remedy}")
-    return arr
-
-
-def _scalar(name: str, value: float, allowed: bool, what: str) -> None:
-    if not (np.isfinite(value) and allowed):
-        raise ValueError(f"{name}={value!r} is not allowed; pass {what}")
-
-
-def _show(arr: np.ndarray) -> str:
-    """An array for an error message, summarised when long."""
-    return np.array2string(arr, threshold=9, edgeitems=3)
+    return _checks.array(name, value, shape=(3,), unit="rad/s")

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tumble import _checks
 from tumble.so3 import validate_rotation
 
 SYMMETRY_RTOL = 1e-9
@@ -42,23 +43,6 @@ AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 Array = NDArray[np.float64]
 
 
-def validate_positive(value: float, *, name: str) -> float:
-    """Return ``value`` as a float, or raise ValueError unless it is finite and > 0.
-
-    Examples
-    --------
-    >>> validate_positive(2, name="radius")
-    2.0
-    """
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        number = float("nan")
-    if not (np.isfinite(number) and number > 0.0):
-        raise ValueError(f"{name} must be a finite number > 0; got {value!r}")
-    return number
-
-
 def validate_mass(mass: float, name: str = "mass") -> float:
     """Return ``mass`` (kg) as a float, or raise ValueError unless finite and > 0.
 
@@ -67,7 +51,7 @@ def validate_mass(mass: float, name: str = "mass") -> float:
     >>> validate_mass(0.25)
     0.25
     """
-    return validate_positive(mass, name=name)
+    return _checks.positive(name, mass, "kg")
 
 
 def validate_inertia(
@@ -103,24 +87,28 @@ def validate_inertia(
     >>> validate_inertia(np.diag([2.0, 1.0, 2 / 3]), allow_unphysical=True).shape
     (3, 3)
     """
-    value = np.asarray(inertia, dtype=float)
-    if value.shape != (3, 3) or not np.all(np.isfinite(value)):
-        raise ValueError(f"{name} must be a finite 3x3 matrix; got {inertia!r}")
+    value = _checks.array(name, inertia, shape=(3, 3), unit="kg m²")
     scale = np.max(np.abs(value))
     if np.max(np.abs(value - value.T)) > SYMMETRY_RTOL * scale:
-        raise ValueError(f"{name} must be symmetric; got {value.tolist()}")
+        raise _checks.fail(name, value.tolist(), "symmetric", "kg m²")
     value = 0.5 * (value + value.T)
     moments = np.linalg.eigvalsh(value)
     if moments[0] <= 0.0:
-        raise ValueError(
-            f"{name} must be positive definite; got {value.tolist()} with principal "
-            f"moments {moments.tolist()}"
+        raise _checks.fail(
+            name,
+            value.tolist(),
+            "positive definite",
+            "kg m²",
+            f"its principal moments are {moments.tolist()}",
         )
     if not allow_unphysical and moments[0] + moments[1] < moments[2] * (1 - TRIANGLE_RTOL):
-        raise ValueError(
-            f"{name} must satisfy the triangle inequality I_a + I_b >= I_c of its principal "
-            f"moments; got {moments.tolist()}. No real body has this inertia; for a "
-            "mathematical test body pass allow_unphysical=True."
+        raise _checks.fail(
+            name,
+            value.tolist(),
+            "within the triangle inequality I_a + I_b >= I_c of its principal moments",
+            "kg m²",
+            f"its principal moments are {moments.tolist()}, and no real body has this "
+            "inertia; for a mathematical test body pass allow_unphysical=True",
         )
     return value
 
@@ -133,14 +121,15 @@ def axis_vector(axis: str | ArrayLike, *, name: str = "axis") -> Array:
     >>> axis_vector([0.0, 0.0, 2.0])
     array([0., 0., 1.])
     """
+    allowed = '"x", "y", "z" or a finite nonzero 3-vector'
     if isinstance(axis, str):
         if axis not in AXES:
-            raise ValueError(f'{name} must be "x", "y", "z" or a nonzero 3-vector; got {axis!r}')
+            raise _checks.fail(name, axis, allowed)
         return np.array(AXES[axis])
     vector = np.asarray(axis, dtype=float)
     norm = np.linalg.norm(vector) if vector.shape == (3,) else 0.0
     if not (np.isfinite(norm) and norm > 0.0):
-        raise ValueError(f'{name} must be "x", "y", "z" or a nonzero 3-vector; got {axis!r}')
+        raise _checks.fail(name, axis, allowed)
     return vector / norm
 
 
@@ -152,10 +141,7 @@ def validate_point(value: ArrayLike, *, name: str) -> Array:
     >>> validate_point([0, 0, 1], name="center")
     array([0., 0., 1.])
     """
-    point = np.asarray(value, dtype=float)
-    if point.shape != (3,) or not np.all(np.isfinite(point)):
-        raise ValueError(f"{name} must be a finite 3-vector (m); got {value!r}")
-    return point
+    return _checks.array(name, value, shape=(3,), unit="m")
 
 
 def _read_only(array: Array) -> Array:
@@ -254,14 +240,14 @@ class MassProperties:
 
 
 def _mass(volume: float, density: float | None, mass: float | None) -> float:
-    if (density is None) == (mass is None):
-        raise ValueError(
-            f"give exactly one of density= (kg/m^3) or mass= (kg); got density={density!r}, "
-            f"mass={mass!r}"
-        )
+    one = "give exactly one of density= (kg/m³) or mass= (kg)"
+    if density is None and mass is None:
+        raise _checks.fail("density", None, "a number when mass is not given", remedy=one)
+    if density is not None and mass is not None:
+        raise _checks.fail("density", density, "None when mass is given", remedy=one)
     if mass is not None:
         return validate_mass(mass)
-    return validate_positive(density, name="density") * volume
+    return _checks.positive("density", density, "kg/m³") * volume
 
 
 def _axisymmetric(
@@ -306,8 +292,8 @@ def cylinder(
     >>> cylinder(1.0, 2.0, mass=1.0).inertia.diagonal()
     array([0.58333333, 0.58333333, 0.5       ])
     """
-    a = validate_positive(radius, name="radius")
-    L = validate_positive(length, name="length")
+    a = _checks.positive("radius", radius, "m")
+    L = _checks.positive("length", length, "m")
     m = _mass(np.pi * a**2 * L, density, mass)
     return _axisymmetric(m, m * a**2 / 2, m * (3 * a**2 + L**2) / 12, axis, center)
 
@@ -332,20 +318,19 @@ def hex_prism(
     >>> hex_prism(1.0, 1.0, mass=12.0).inertia.diagonal()
     array([3.5, 3.5, 5. ])
     """
-    a = validate_positive(circumradius, name="circumradius")
-    L = validate_positive(length, name="length")
+    a = _checks.positive("circumradius", circumradius, "m")
+    L = _checks.positive("length", length, "m")
     m = _mass(1.5 * np.sqrt(3.0) * a**2 * L, density, mass)
     return _axisymmetric(m, 5 * m * a**2 / 12, m * (5 * a**2 / 24 + L**2 / 12), axis, center)
 
 
 def validate_torus_radii(major_radius: float, minor_radius: float) -> tuple[float, float]:
     """``(R, r)`` of a ring torus: both positive and ``r < R``; else a ValueError naming them."""
-    R = validate_positive(major_radius, name="major_radius")
-    r = validate_positive(minor_radius, name="minor_radius")
+    R = _checks.positive("major_radius", major_radius, "m")
+    r = _checks.positive("minor_radius", minor_radius, "m")
     if r >= R:
-        raise ValueError(
-            f"minor_radius must be less than major_radius ({R!r}) for a ring torus; "
-            f"got minor_radius={minor_radius!r}"
+        raise _checks.fail(
+            "minor_radius", minor_radius, f"less than major_radius={R!r} for a ring torus", "m"
         )
     return R, r
 
@@ -393,7 +378,7 @@ def sphere(
     >>> sphere(1.0, mass=5.0).inertia.diagonal()
     array([2., 2., 2.])
     """
-    a = validate_positive(radius, name="radius")
+    a = _checks.positive("radius", radius, "m")
     m = _mass(4 * np.pi * a**3 / 3, density, mass)
     return _axisymmetric(m, 0.4 * m * a**2, 0.4 * m * a**2, "z", center)
 
@@ -421,9 +406,7 @@ def box(
     >>> box([1.0, 2.0, 3.0], mass=12.0).inertia.diagonal()
     array([13., 10.,  5.])
     """
-    sides = np.asarray(extents, dtype=float)
-    if sides.shape != (3,) or not np.all(np.isfinite(sides) & (sides > 0)):
-        raise ValueError(f"extents must be three finite lengths > 0 (m); got {extents!r}")
+    sides = _checks.array("extents", extents, shape=(3,), unit="m", positive=True)
     m = _mass(float(np.prod(sides)), density, mass)
     squares = sides**2
     inertia = m * np.diag(squares.sum() - squares) / 12

@@ -18,14 +18,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tumble import _checks
 from tumble._atomic import atomic_write
-from tumble.mass import (
-    MassProperties,
-    axis_vector,
-    validate_point,
-    validate_positive,
-    validate_torus_radii,
-)
+from tumble.mass import MassProperties, axis_vector, validate_point, validate_torus_radii
 from tumble.so3 import validate_rotation
 
 if TYPE_CHECKING:
@@ -37,12 +32,6 @@ LOAD_FORMATS = ("glb", "gltf", "obj", "off", "ply", "stl")
 """File extensions :func:`load` accepts (trimesh's triangle-mesh readers)."""
 SAVE_FORMATS = ("glb", "obj", "off", "ply", "stl")
 """File extensions :func:`save` writes (trimesh's mesh exporters)."""
-
-
-def _sections(value: int, name: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 3:
-        raise ValueError(f"{name} must be an integer >= 3; got {value!r}")
-    return int(value)
 
 
 def _placement(axis: str | ArrayLike, center: ArrayLike) -> np.ndarray:
@@ -89,8 +78,8 @@ def torus(
     import trimesh
 
     R, r = validate_torus_radii(major_radius, minor_radius)
-    n = _sections(sections, "sections")
-    k = n if minor_sections is None else _sections(minor_sections, "minor_sections")
+    n = _checks.count("sections", sections, 3)
+    k = n if minor_sections is None else _checks.count("minor_sections", minor_sections, 3)
     return trimesh.creation.torus(
         R, r, major_sections=n, minor_sections=k, transform=_placement(axis, center)
     )
@@ -114,9 +103,9 @@ def cylinder(
     """
     import trimesh
 
-    a = validate_positive(radius, name="radius")
-    L = validate_positive(length, name="length")
-    n = _sections(sections, "sections")
+    a = _checks.positive("radius", radius, "m")
+    L = _checks.positive("length", length, "m")
+    n = _checks.count("sections", sections, 3)
     return trimesh.creation.cylinder(
         radius=a, height=L, sections=n, transform=_placement(axis, center)
     )
@@ -154,9 +143,7 @@ def box(
     """
     import trimesh
 
-    sides = np.asarray(extents, dtype=float)
-    if sides.shape != (3,) or not np.all(np.isfinite(sides) & (sides > 0)):
-        raise ValueError(f"extents must be three finite lengths > 0 (m); got {extents!r}")
+    sides = _checks.array("extents", extents, shape=(3,), unit="m", positive=True)
     transform = np.eye(4)
     if rotation is not None:
         transform[:3, :3] = validate_rotation(rotation, name="rotation")
@@ -176,12 +163,9 @@ def sphere(
     """
     import trimesh
 
-    a = validate_positive(radius, name="radius")
-    if isinstance(subdivisions, bool) or not isinstance(subdivisions, (int, np.integer)):
-        raise ValueError(f"subdivisions must be an integer >= 0; got {subdivisions!r}")
-    if subdivisions < 0:
-        raise ValueError(f"subdivisions must be an integer >= 0; got {subdivisions!r}")
-    mesh = trimesh.creation.icosphere(subdivisions=int(subdivisions), radius=a)
+    a = _checks.positive("radius", radius, "m")
+    subdivisions = _checks.count("subdivisions", subdivisions, 0)
+    mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=a)
     return mesh.apply_translation(validate_point(center, name="center"))
 
 
@@ -226,18 +210,20 @@ def validate_solid(mesh: object, *, name: str = "mesh") -> trimesh.Trimesh:
     import trimesh
 
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise ValueError(
-            f"{name} must be a trimesh.Trimesh with faces or a mesh file path; got {mesh!r}"
-        )
+        raise _checks.fail(name, mesh, "a trimesh.Trimesh with faces or a mesh file path")
     if not mesh.is_watertight:
-        raise ValueError(
-            f"{name} must be a closed (watertight) surface; got an open mesh {mesh!r}. "
-            "Repair it, e.g. trimesh.repair.fill_holes(mesh)."
+        raise _checks.fail(
+            name,
+            mesh,
+            "a closed (watertight) surface",
+            remedy="it is open; repair it, e.g. trimesh.repair.fill_holes(mesh)",
         )
     if not mesh.is_winding_consistent:
-        raise ValueError(
-            f"{name} must have consistently wound faces; got {mesh!r}. Repair it, e.g. "
-            "trimesh.repair.fix_winding(mesh)."
+        raise _checks.fail(
+            name,
+            mesh,
+            "a mesh with consistently wound faces",
+            remedy="repair it, e.g. trimesh.repair.fix_winding(mesh)",
         )
     return mesh
 
@@ -245,8 +231,8 @@ def validate_solid(mesh: object, *, name: str = "mesh") -> trimesh.Trimesh:
 def _suffix(path: Path, formats: tuple[str, ...], name: str) -> str:
     suffix = path.suffix.lower().lstrip(".")
     if suffix not in formats:
-        raise ValueError(
-            f"{name} must end in one of {', '.join('.' + f for f in formats)}; got {str(path)!r}"
+        raise _checks.fail(
+            name, str(path), f"a file name ending in one of {', '.join('.' + f for f in formats)}"
         )
     return suffix
 
@@ -283,18 +269,20 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
 
     file = Path(path)
     if not file.is_file():
-        raise ValueError(f"path must be an existing mesh file; got {str(path)!r} (not found)")
+        raise _checks.fail("path", str(path), "an existing mesh file", remedy="not found")
     file_type = _suffix(file, LOAD_FORMATS, "path")
     try:
         mesh = trimesh.load_mesh(file, file_type=file_type)
     except Exception as error:  # trimesh raises many types for a bad file
-        raise ValueError(
-            f"path must be a readable {file_type} mesh file; could not read {str(path)!r}: {error}"
+        raise _checks.fail(
+            "path", str(path), f"a readable {file_type} mesh file", remedy=f"reading it: {error}"
         ) from error
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise ValueError(
-            f"path must be a mesh file with triangles; {str(path)!r} has none (empty or not "
-            f"a {file_type} file)"
+        raise _checks.fail(
+            "path",
+            str(path),
+            "a mesh file with triangles",
+            remedy=f"it has none (empty or not a {file_type} file)",
         )
     return mesh
 
@@ -320,11 +308,11 @@ def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
     import trimesh
 
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
-        raise ValueError(f"mesh must be a trimesh.Trimesh with faces; got {mesh!r}")
+        raise _checks.fail("mesh", mesh, "a trimesh.Trimesh with faces")
     file = Path(path)
     file_type = _suffix(file, SAVE_FORMATS, "path")
     if not file.parent.is_dir():
-        raise ValueError(f"path must be in an existing folder; got {str(path)!r}")
+        raise _checks.fail("path", str(path), "a file in an existing folder")
     return atomic_write(file, lambda temporary: mesh.export(temporary, file_type=file_type))
 
 
@@ -362,17 +350,20 @@ def from_mesh(
     """
     import trimesh
 
-    rho = validate_positive(density, name="density")
+    rho = _checks.positive("density", density, "kg/m³")
+    given = mesh_or_path
     if isinstance(mesh_or_path, (str, PathLike)):
         mesh_or_path = load(mesh_or_path)
     mesh = validate_solid(mesh_or_path, name="mesh_or_path")
     triangles = mesh.triangles
     if mesh.volume < 0:
         if not fix_inside_out:
-            raise ValueError(
-                f"mesh_or_path must be outward-oriented; got an inside-out mesh (volume "
-                f"{mesh.volume:.6g} < 0). Flip it with mesh.invert(), or pass "
-                "fix_inside_out=True."
+            raise _checks.fail(
+                "mesh_or_path",
+                given,
+                "outward-oriented",
+                remedy=f"it is inside-out (volume {mesh.volume:.6g} < 0); flip it with "
+                "mesh.invert(), or pass fix_inside_out=True",
             )
         warnings.warn("mesh is inside-out (negative volume); flipped", UserWarning, 2)
         triangles = triangles[:, ::-1]

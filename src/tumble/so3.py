@@ -18,6 +18,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tumble import _checks
+
 SMALL_ANGLE = 1e-3
 """Below this angle (rad) sin(x)/x is replaced by its Taylor series (error < x**6/5040)."""
 SERIES_ANGLE = 0.1
@@ -318,13 +320,17 @@ def quat_normalize(q: ArrayLike, *, name: str = "q") -> Array:
     """
     q = np.asarray(q, dtype=float)
     if q.shape[-1:] != (4,):
-        raise ValueError(f"{name} must have shape (..., 4) [w, x, y, z]; got shape {q.shape}")
+        raise _checks.fail(
+            name, q, "of shape (..., 4), [w, x, y, z]", remedy=f"it has shape {q.shape}"
+        )
     norm = np.linalg.norm(q, axis=-1, keepdims=True)
-    bad = ~np.isfinite(norm) | (norm == 0.0)
+    bad = ~np.isfinite(norm[..., 0]) | (norm[..., 0] == 0.0)
     if np.any(bad):
-        value = q[np.nonzero(bad[..., 0])][0] if q.ndim > 1 else q
-        raise ValueError(
-            f"{name} must be a finite quaternion [w, x, y, z] of nonzero norm; got {value}"
+        index = _first(bad)
+        raise _checks.fail(
+            _label(name, index),
+            q[index].tolist(),
+            "a finite quaternion [w, x, y, z] of nonzero norm",
         )
     return q / norm
 
@@ -563,13 +569,27 @@ def validate_rotation(R: ArrayLike, *, name: str = "R", atol: float = 1e-9) -> A
     """
     R = np.asarray(R, dtype=float)
     if R.shape[-2:] != (3, 3):
-        raise ValueError(f"{name} must have shape (..., 3, 3); got shape {R.shape}")
-    defect = np.max(np.abs(R.swapaxes(-1, -2) @ R - np.eye(3)), initial=0.0)
+        raise _checks.fail(name, R, "of shape (..., 3, 3)", remedy=f"it has shape {R.shape}")
+    defect = np.max(np.abs(R.swapaxes(-1, -2) @ R - np.eye(3)), axis=(-2, -1))
     det = np.linalg.det(R)
-    if not np.isfinite(defect) or defect > atol or np.any(det <= 0.0):
-        raise ValueError(
-            f"{name} must be a rotation matrix (R^T R = I within {atol:g}, det R = +1); got "
-            f"max|R^T R - I| = {defect:.3g}, det R = {np.min(det):.6g}. Remedy: "
-            f"re-orthonormalise, e.g. tumble.so3.exp(tumble.so3.log({name}))."
+    bad = ~(defect <= atol) | ~(det > 0.0)  # NaN is bad too
+    if np.any(bad):
+        index = _first(bad)
+        raise _checks.fail(
+            _label(name, index),
+            R[index].tolist(),
+            f"a rotation matrix (R^T R = I within {atol:g}, det R = +1)",
+            remedy=f"it has max|R^T R - I| = {defect[index]:.3g}, det R = {det[index]:.6g}; "
+            f"re-orthonormalise, e.g. tumble.so3.exp(tumble.so3.log({name}))",
         )
     return R.copy()
+
+
+def _first(bad: NDArray[np.bool_]) -> tuple[int, ...]:
+    """Index of the first True in ``bad`` (``()`` for a 0-d array)."""
+    return tuple(int(i) for i in np.argwhere(bad)[0])
+
+
+def _label(name: str, index: tuple[int, ...]) -> str:
+    """``name`` or ``name[i, j]``: which item of a batch an error is about."""
+    return f"{name}[{', '.join(map(str, index))}]" if index else name

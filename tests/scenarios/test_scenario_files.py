@@ -243,7 +243,7 @@ BAD_FILES = {
     "torus radii": (
         RIGID + '[options.body]\nshape = "torus"\nmajor_radius = 1.0\nminor_radius = 2.0\n'
         "density = 1.0\n",
-        "options.body: minor_radius must be less than major_radius",
+        "options.body: minor_radius=2.0 is not allowed: must be less than major_radius=1.0",
     ),
     "mesh file not found": (
         RIGID + '[options.body]\nmesh = "missing.stl"\ndensity = 1000.0\n',
@@ -261,7 +261,8 @@ BAD_FILES = {
     ),
     "R0 not a rotation": (
         RIGID + CYLINDER + "[options.initial]\nR0 = [[1.0, 0, 0], [0, 1.0, 0], [0, 0, -1.0]]\n",
-        "options.initial: R0 must be a rotation matrix",
+        "options.initial: R0=[[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]] is not allowed: "
+        "must be a rotation matrix",
     ),
     "zero quaternion": (
         RIGID + CYLINDER + "[options.initial]\nq0 = [0.0, 0.0, 0.0, 0.0]\n",
@@ -291,7 +292,8 @@ BAD_FILES = {
     ),
     "tolerance for a fixed step": (
         RIGID + "[options]\nrtol = 1e-6\n" + CYLINDER,
-        "options: rtol=1e-06, atol=None: tolerances apply only to method='rkmk45'",
+        "options: rtol=1e-06 is not allowed: must be None for the fixed-step method 'rkmk4'; "
+        "tolerances apply only to method='rkmk45'",
     ),
 }
 

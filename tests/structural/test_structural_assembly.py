@@ -167,18 +167,20 @@ def test_moderate_mesh_does_not_warn():
 def test_cantilever_rejects_bad_numbers(argument, value):
     kwargs = {"length": 1.0, "n_elements": 4, "width": 0.01, "height": 0.01, **STEEL}
     kwargs[argument] = value
-    with pytest.raises(ValueError, match=rf"^{argument} must be .*; got {value!r}"):
+    with pytest.raises(ValueError, match=rf"^{argument}={value!r} is not allowed: must be "):
         structural.cantilever(**kwargs)
 
 
 @pytest.mark.parametrize("n_elements", [0, -3, 2.5, True])
 def test_cantilever_rejects_bad_element_counts(n_elements):
-    with pytest.raises(ValueError, match=r"n_elements must be an integer >= 1; got"):
+    with pytest.raises(ValueError, match=r"n_elements=.* is not allowed: must be an integer >= 1"):
         structural.cantilever(1.0, n_elements, width=0.01, height=0.01, **STEEL)
 
 
 def test_build_frame_rejects_unknown_support():
-    with pytest.raises(ValueError, match=r"supports\[0\] must be one of 'clamped', .*'fixed'"):
+    with pytest.raises(
+        ValueError, match=r"supports\[0\]='fixed' is not allowed: must be one of 'clamped', "
+    ):
         structural.build_frame(
             [[0, 0], [1, 0]], [[0, 1]], area=1.0, second_moment=1.0, supports={0: "fixed"}, **STEEL
         )
@@ -197,7 +199,9 @@ def test_build_frame_rejects_coincident_nodes():
 
 
 def test_build_frame_rejects_node_out_of_range():
-    with pytest.raises(ValueError, match=r"connectivity must hold node indices 0..1; got"):
+    with pytest.raises(
+        ValueError, match=r"connectivity=.* is not allowed: must be node indices 0..1"
+    ):
         structural.build_frame(
             [[0, 0], [1, 0]],
             [[0, 2]],
@@ -210,13 +214,16 @@ def test_build_frame_rejects_node_out_of_range():
 
 def test_natural_frequencies_rejects_too_many_modes():
     beam = structural.cantilever(1.0, 2, width=0.01, height=0.01, **STEEL)
-    with pytest.raises(ValueError, match="k must be at most n_dofs = 4; got 5"):
+    with pytest.raises(
+        ValueError, match="k=5 is not allowed: must be an integer from 1 to n_dofs = 4"
+    ):
         beam.natural_frequencies(5)
 
 
 def test_build_frame_rejects_a_load_that_is_not_three_numbers():
     with pytest.raises(
-        ValueError, match=r"loads\[1\] must be \(F_x, F_y, M_z\); got \[0.0, 1.0\]"
+        ValueError,
+        match=r"loads\[1\]=\(0.0, 1.0\) is not allowed: must be of shape \(3,\).*F_x, F_y",
     ):
         structural.build_frame(
             [[0, 0], [1, 0]],
@@ -230,7 +237,9 @@ def test_build_frame_rejects_a_load_that_is_not_three_numbers():
 
 
 def test_build_frame_rejects_supports_that_fix_every_dof():
-    with pytest.raises(ValueError, match="supports fix every DOF"):
+    with pytest.raises(
+        ValueError, match="supports=.* is not allowed: must be supports that leave some DOF free"
+    ):
         structural.build_frame(
             [[0, 0], [1, 0]],
             [[0, 1]],
@@ -242,7 +251,9 @@ def test_build_frame_rejects_supports_that_fix_every_dof():
 
 
 def test_build_frame_rejects_a_free_floating_frame():
-    with pytest.raises(ValueError, match="supports leave a mechanism"):
+    with pytest.raises(
+        ValueError, match="supports=.* is not allowed: must be supports that leave no mechanism"
+    ):
         structural.build_frame(
             [[0, 0], [1, 0], [2, 0]],
             [[0, 1], [1, 2]],

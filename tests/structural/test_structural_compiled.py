@@ -112,7 +112,11 @@ def test_integrate_picks_the_banded_path_for_a_beam_and_sparse_lu_for_a_wheel(ca
 
 
 def test_compiled_true_refuses_a_band_wider_than_the_kernel_takes():
-    with pytest.raises(ValueError, match=rf"half-bandwidth <= {MAX_BANDWIDTH}; this one has 27"):
+    with pytest.raises(
+        ValueError,
+        match=rf"compiled=True is not allowed: must be None or False .* > {MAX_BANDWIDTH}; "
+        "this one has 27",
+    ):
         structural.integrate(wheel(12), "midpoint", 1e-4, n_steps=2, compiled=True)
 
 

@@ -80,5 +80,5 @@ def test_beam_frames_are_rgb_images_that_move(result):
 
 
 def test_bad_option_value_is_named():
-    with pytest.raises(ValueError, match=r"n_steps must be an integer >= 1; got 0"):
+    with pytest.raises(ValueError, match=r"n_steps=0 is not allowed: must be an integer >= 1"):
         scenario.run(n_steps=0)

@@ -192,15 +192,15 @@ def test_progress_bar_does_not_change_the_result(beam, dt):
 
 @pytest.mark.parametrize("dt", [0.0, -1e-3, np.nan, np.inf, "1e-3"])
 def test_integrate_rejects_bad_time_steps(beam, dt):
-    with pytest.raises(ValueError, match=r"dt must be a finite number > 0 s; got"):
+    with pytest.raises(ValueError, match=r"dt=.* is not allowed: must be finite and > 0 \(s\)"):
         structural.integrate(beam, "midpoint", dt, n_steps=1)
 
 
 def test_integrate_rejects_unknown_scheme_and_lists_the_schemes(beam):
     with pytest.raises(
         ValueError,
-        match=r"scheme must be one of 'explicit', 'semi-implicit', "
-        r"'implicit', 'midpoint', 'newmark'; got 'rk4'",
+        match=r"scheme='rk4' is not allowed: must be one of 'explicit', 'semi-implicit', "
+        r"'implicit', 'midpoint', 'newmark'",
     ):
         structural.integrate(beam, "rk4", 1e-4, n_steps=1)
 
@@ -212,13 +212,13 @@ def test_integrate_needs_exactly_one_of_n_steps_and_t_end(beam, steps):
 
 
 def test_integrate_rejects_wrong_initial_shape(beam):
-    with pytest.raises(ValueError, match=r"x0 must have shape \(40,\); got \(3,\)"):
+    with pytest.raises(ValueError, match=r"x0=.* is not allowed: must be of shape \(40,\)"):
         structural.integrate(beam, "midpoint", 1e-4, n_steps=1, x0=np.zeros(3))
 
 
 @pytest.mark.parametrize("beta, gamma, name", [(-0.1, 0.5, "beta"), (0.25, 0.0, "gamma")])
 def test_newmark_rejects_bad_parameters(beta, gamma, name):
-    with pytest.raises(ValueError, match=rf"{name} must be a finite number"):
+    with pytest.raises(ValueError, match=rf"{name}=.* is not allowed: must be finite"):
         structural.Newmark(beta=beta, gamma=gamma)
 
 
@@ -231,5 +231,7 @@ def test_rayleigh_damping_from_ratio_hits_the_ratio_at_both_frequencies():
 
 
 def test_rayleigh_damping_rejects_negative_coefficients():
-    with pytest.raises(ValueError, match=r"mass_coefficient must be a finite number >= 0; got -1"):
+    with pytest.raises(
+        ValueError, match=r"mass_coefficient=-1.0 is not allowed: must be finite and >= 0"
+    ):
         structural.RayleighDamping(mass_coefficient=-1.0)

@@ -17,6 +17,8 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tumble import _checks
+
 
 class State(NamedTuple):
     """The rigid-body state at one instant, as user callables receive it.
@@ -43,15 +45,12 @@ VectorOrCallable = ArrayLike | Callable[[float, State], ArrayLike]
 _ZERO = np.zeros(3)
 
 
-def _vector(value: ArrayLike, name: str) -> np.ndarray:
-    array = np.asarray(value, dtype=float)
-    if array.shape != (3,) or not np.all(np.isfinite(array)):
-        raise ValueError(f"{name}={value!r} must be 3 finite numbers")
-    return array
+def _vector(value: ArrayLike, name: str, unit: str) -> np.ndarray:
+    return _checks.array(name, value, shape=(3,), unit=unit)
 
 
-def _vector_or_callable(value: VectorOrCallable, name: str):
-    return value if callable(value) else _vector(value, name)
+def _vector_or_callable(value: VectorOrCallable, name: str, unit: str):
+    return value if callable(value) else _vector(value, name, unit)
 
 
 def _evaluate(value, t: float, state: State, name: str) -> np.ndarray:
@@ -59,7 +58,7 @@ def _evaluate(value, t: float, state: State, name: str) -> np.ndarray:
         return value
     result = np.asarray(value(t, state), dtype=float)
     if result.shape != (3,):
-        raise ValueError(f"{name}(t, state) returned shape {result.shape}; expected (3,)")
+        raise _checks.fail(f"{name}(t, state)", result, "of shape (3,)")
     return result
 
 
@@ -76,7 +75,7 @@ class Gravity:
     g: ArrayLike = (0.0, 0.0, -9.81)
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "g", _vector(self.g, "g"))
+        object.__setattr__(self, "g", _vector(self.g, "g", "m/s²"))
 
     compiled = True
 
@@ -102,9 +101,9 @@ class Force:
     point: ArrayLike | None = None
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "force", _vector_or_callable(self.force, "force"))
+        object.__setattr__(self, "force", _vector_or_callable(self.force, "force", "N"))
         if self.point is not None:
-            object.__setattr__(self, "point", _vector(self.point, "point"))
+            object.__setattr__(self, "point", _vector(self.point, "point", "m"))
 
     @property
     def compiled(self) -> bool:
@@ -124,7 +123,7 @@ class Torque:
     torque: VectorOrCallable
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "torque", _vector_or_callable(self.torque, "torque"))
+        object.__setattr__(self, "torque", _vector_or_callable(self.torque, "torque", "N m"))
 
     @property
     def compiled(self) -> bool:
@@ -157,10 +156,9 @@ class Impulse:
     time: float = 0.0
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "point", _vector(self.point, "point"))
-        object.__setattr__(self, "impulse", _vector(self.impulse, "impulse"))
-        if not np.isfinite(self.time):
-            raise ValueError(f"time={self.time!r} must be finite")
+        object.__setattr__(self, "point", _vector(self.point, "point", "m"))
+        object.__setattr__(self, "impulse", _vector(self.impulse, "impulse", "N s"))
+        _checks.finite("time", self.time, "s")
 
     def kick(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(Δp, ΔL)`` for a body whose centre of mass is at ``x``."""
@@ -179,9 +177,10 @@ def split_loads(forces) -> tuple[list[Load], list[Impulse]]:
         elif isinstance(item, Gravity | Force | Torque):
             loads.append(item)
         else:
-            raise ValueError(
-                f"forces[{index}]={item!r} is not a load; use tumble.Gravity, tumble.Force, "
-                "tumble.Torque or tumble.Impulse"
+            raise _checks.fail(
+                f"forces[{index}]",
+                item,
+                "a load: tumble.Gravity, tumble.Force, tumble.Torque or tumble.Impulse",
             )
     return loads, impulses
 

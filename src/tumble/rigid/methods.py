@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from tumble import _checks
 from tumble.ode.tableaux import DORMAND_PRINCE8, EULER, FEHLBERG45, RK4, ButcherTableau
 
 
@@ -95,6 +96,4 @@ METHODS: dict[str, Method] = {
 
 def get_method(name: str) -> Method:
     """The method called ``name``; a ValueError lists the known ones."""
-    if name not in METHODS:
-        raise ValueError(f"method={name!r} is not known; choose one of {list(METHODS)}")
-    return METHODS[name]
+    return METHODS[_checks.choice("method", name, METHODS, remedy="see tumble.rigid.METHODS")]

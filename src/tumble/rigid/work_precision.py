@@ -16,6 +16,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tumble import _checks
 from tumble.exact import free_body_rotation
 from tumble.rigid.body import RigidBody
 from tumble.rigid.methods import get_method
@@ -134,10 +135,10 @@ def work_precision(
     points = []
     for spec in specs:
         if spec.adaptive:
-            settings = _positive_values("tolerances", tolerances, float)
+            settings = _checks.values("tolerances", tolerances, positive=True).tolist()
             runs = [{"rtol": tol, "atol": tol} for tol in settings]
         else:
-            settings = [t_end / n for n in _positive_values("steps", steps, int)]
+            settings = [t_end / n for n in _step_counts(steps)]
             runs = [{"h": h} for h in settings]
         for setting, options in zip(settings, runs, strict=True):
             seconds, run = _timed(repeat, body, t_end, spec.name, omega0, options)
@@ -163,25 +164,16 @@ def _timed(repeat: int, body, t_end, method, omega0, options):
 def _check(methods, t_end, repeat):
     methods = (methods,) if isinstance(methods, str) else tuple(methods)
     if not methods:
-        raise ValueError("methods=() is empty: name at least one of tumble.rigid.METHODS")
+        raise _checks.fail("methods", methods, "at least one name from tumble.rigid.METHODS")
     specs = [get_method(name) for name in methods]
-    if not (isinstance(t_end, int | float) and np.isfinite(t_end) and t_end > 0):
-        raise ValueError(f"t_end={t_end!r} must be a finite time > 0 (s)")
-    if isinstance(repeat, bool) or not isinstance(repeat, int) or repeat < 1:
-        raise ValueError(f"repeat={repeat!r} must be an integer ≥ 1")
-    return specs, float(t_end), repeat
+    return specs, _checks.positive("t_end", t_end, "s"), _checks.count("repeat", repeat)
 
 
-def _positive_values(name: str, values, kind) -> list:
-    values = list(values)
-    good = all(
-        isinstance(v, int | float | np.number) and not isinstance(v, bool) and v > 0
-        for v in values
-    )
-    if not values or not good or (kind is int and any(int(v) != v for v in values)):
-        what = "positive integers" if kind is int else "positive numbers"
-        raise ValueError(f"{name}={tuple(values)!r} must be a non-empty sequence of {what}")
-    return [kind(v) for v in values]
+def _step_counts(steps) -> list[int]:
+    steps = tuple(steps)
+    if not steps:
+        raise _checks.fail("steps", steps, "at least one number of steps")
+    return [_checks.count(f"steps[{i}]", n) for i, n in enumerate(steps)]
 
 
 def table(points: Sequence[WorkPrecisionPoint]) -> list[dict]:

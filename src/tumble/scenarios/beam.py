@@ -16,9 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from tumble import structural
+from tumble import _checks, structural
 from tumble.io import ScenarioResult
-from tumble.structural import validation
 from tumble.viz import structural as viz
 
 NAME = "beam"
@@ -75,7 +74,7 @@ def run(
         ("sweep_steps", sweep_steps),
         ("frame_every", frame_every),
     ):
-        validation.count(name, value)
+        _checks.count(name, value)
     beam = structural.cantilever(length, n_elements, E, rho, width, height, tip_load)
     omega = beam.natural_frequencies(4)
     dt = 2 * np.pi / omega[0] / steps_per_period
@@ -258,9 +257,11 @@ def stability(
     >>> result.summary["schemes"]["semi-implicit"]["stable"]
     [True, False]
     """
-    validation.count("sweep_steps", sweep_steps)
+    _checks.count("sweep_steps", sweep_steps)
     if not schemes:
-        raise ValueError("schemes=() is not allowed: name at least one scheme")
+        raise _checks.fail(
+            "schemes", schemes, f"at least one of {', '.join(map(repr, structural.SCHEMES))}"
+        )
     beam = structural.cantilever(1.0, n_elements, 210e9, 7850.0, 0.01, 0.01, 1.0)
     critical = structural.critical_dt(beam, "semi-implicit")
     dts = critical.dt * np.asarray(factors, dtype=float)

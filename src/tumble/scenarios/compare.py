@@ -14,6 +14,7 @@ from dataclasses import asdict
 
 import numpy as np
 
+from tumble import _checks
 from tumble.io import ScenarioResult
 from tumble.rigid.methods import METHODS
 from tumble.scenarios import registry
@@ -59,19 +60,14 @@ def run(
         ``summary["best"]``: per method the smallest error reached and its time; figure
         ``work_precision.png``; the points as the dataset.
     """
-    if scenario not in FREE_BODY_SCENARIOS:
-        raise ValueError(
-            f"scenario={scenario!r} has no torque-free body to compare methods on; "
-            f"choose one of {list(FREE_BODY_SCENARIOS)}"
-        )
+    _checks.choice(
+        "scenario", scenario, FREE_BODY_SCENARIOS, "the others have no torque-free body to compare"
+    )
     methods = [methods] if isinstance(methods, str) else list(methods)
     unknown = [m for m in methods if m not in METHODS]
     if not methods or unknown:
-        raise ValueError(
-            f"methods={methods!r} is not allowed: name one or more of {sorted(METHODS)}"
-        )
-    if not (np.isfinite(t_end) and t_end > 0):
-        raise ValueError(f"t_end={t_end!r} is not allowed: it must be finite and > 0 (s)")
+        raise _checks.fail("methods", methods, f"one or more of {sorted(METHODS)}")
+    _checks.positive("t_end", t_end, "s")
     from tumble.rigid.work_precision import work_precision
 
     body, omega0 = registry.get(scenario).free_body()

@@ -27,7 +27,7 @@ from functools import partial
 
 import numpy as np
 
-from tumble import exact
+from tumble import _checks, exact
 from tumble.io import ScenarioResult
 from tumble.rigid import METHODS, RigidBody, simulate
 from tumble.viz import rigid
@@ -149,14 +149,13 @@ def run(
     """
     methods = (methods,) if isinstance(methods, str) else tuple(methods)
     if not methods:
-        raise ValueError("methods=() is not allowed: name at least one method")
+        raise _checks.fail("methods", methods, "at least one method name")
     for method in methods:
         _check_fixed_step("methods", methods, method)
     counts = np.asarray(step_counts)
     if counts.ndim != 1 or len(set(counts.tolist())) < 2 or np.any(counts < 1):
-        raise ValueError(
-            f"step_counts={step_counts!r} is not allowed: give at least two distinct positive "
-            "numbers of steps"
+        raise _checks.fail(
+            "step_counts", step_counts, "at least two distinct numbers of steps, each >= 1"
         )
     step_sizes = t_end / counts.astype(float)
     results = {method: _study(method, step_sizes, t_end) for method in methods}
@@ -211,9 +210,8 @@ def _check_fixed_step(argument: str, value, method) -> None:
         why = "is adaptive: h is only its first step, so its error has no order in h"
     else:
         why = "is not a rigid-body method"
-    raise ValueError(
-        f"{argument}={value!r}: {method!r} {why}; choose fixed-step methods from "
-        f"{list(FIXED_STEP_METHODS)}"
+    raise _checks.fail(
+        argument, value, f"fixed-step, from {list(FIXED_STEP_METHODS)}", remedy=f"{method!r} {why}"
     )
 
 

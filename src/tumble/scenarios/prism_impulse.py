@@ -25,7 +25,7 @@ from functools import partial
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble import mass, meshes
+from tumble import _checks, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import Impulse, RigidBody, simulate
 from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
@@ -57,7 +57,7 @@ def default_vertex(center: ArrayLike, circumradius: float, length: float) -> np.
 def _methods(methods: Sequence[str] | str) -> tuple[str, ...]:
     methods = (methods,) if isinstance(methods, str) else tuple(methods)
     if not methods:
-        raise ValueError("methods=() is not allowed: name at least one method")
+        raise _checks.fail("methods", methods, "at least one method name")
     return methods
 
 
@@ -70,13 +70,17 @@ def _check_hit(mesh, vertex: np.ndarray, hit_from: np.ndarray) -> None:
     """The hit point on the prism's surface, the outside point outside it (the prism is convex)."""
     distance = _signed_distance(mesh, vertex)
     if abs(distance) > 1e-9 * max(1.0, float(np.abs(vertex).max())):
-        raise ValueError(
-            f"vertex={vertex.tolist()!r} is not on the prism's surface (it lies {distance:g} m "
-            "outside it; negative: inside); pick a vertex of the mesh, e.g. the default"
+        raise _checks.fail(
+            "vertex",
+            vertex.tolist(),
+            "a point on the prism's surface",
+            "m",
+            f"it lies {distance:g} m outside it (negative: inside); pick a vertex of the mesh, "
+            "e.g. the default",
         )
     if _signed_distance(mesh, hit_from) <= 0:
-        raise ValueError(
-            f"hit_from={hit_from.tolist()!r} lies inside the prism; pick a point outside"
+        raise _checks.fail(
+            "hit_from", hit_from.tolist(), "a point outside the prism", "m", "it lies inside"
         )
 
 

@@ -6,6 +6,7 @@ from functools import partial
 
 import numpy as np
 
+from tumble import _checks
 from tumble.io import ScenarioResult
 from tumble.ode import solve
 
@@ -63,17 +64,17 @@ def run(
     >>> round(result.summary["impact_time"], 6), round(result.summary["range"], 4)
     (72.080202, 25484.1998)
     """
-    if not (np.isfinite(speed) and speed > 0):
-        raise ValueError(f"speed={speed!r} is not allowed: it must be finite and > 0 (m/s)")
-    if not (np.isfinite(angle) and 0 < angle < 180):
-        raise ValueError(f"angle={angle!r} is not allowed: it must lie in (0, 180) degrees")
-    if not (np.isfinite(g) and g > 0):
-        raise ValueError(f"g={g!r} is not allowed: it must be finite and > 0 (m/s²)")
+    _checks.positive("speed", speed, "m/s")
+    if not 0 < _checks.finite("angle", angle, "degrees") < 180:
+        raise _checks.fail("angle", angle, "in (0, 180)", "degrees")
+    _checks.positive("g", g, "m/s²")
     theta = np.radians(angle)
     y0 = [0.0, 0.0, speed * np.cos(theta), speed * np.sin(theta)]
     ode = solve(partial(_free_flight, g=g), (0.0, t_max), y0, method=method, h=h, events=_ground)
     if ode.status != 1:
-        raise ValueError(f"t_max={t_max!r} s is too short: the projectile is still flying")
+        raise _checks.fail(
+            "t_max", t_max, "long enough for the projectile to land", "s", "it is still flying"
+        )
     impact_time = float(ode.t_events[0][0])
     summary = {
         "scenario": NAME,

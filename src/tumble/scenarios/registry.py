@@ -10,6 +10,8 @@ from __future__ import annotations
 from importlib import import_module
 from types import ModuleType
 
+from tumble import _checks
+
 _MODULES = {
     "projectile": "tumble.scenarios.projectile",
     "torus-spin": "tumble.scenarios.torus_spin",
@@ -41,6 +43,4 @@ def get(name: str) -> ModuleType:
     ValueError
         If there is no such scenario (the message lists the known ones).
     """
-    if name not in _MODULES:
-        raise ValueError(f"scenario={name!r} is not known; choose one of {names()}")
-    return import_module(_MODULES[name])
+    return import_module(_MODULES[_checks.choice("scenario", name, names())])

@@ -19,7 +19,7 @@ from functools import partial
 
 import numpy as np
 
-from tumble import exact, meshes
+from tumble import _checks, exact, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, Trajectory, simulate
 from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
@@ -41,7 +41,7 @@ SEED_EULER_AT_1 = np.array(
 def _methods(methods: Sequence[str] | str) -> tuple[str, ...]:
     methods = (methods,) if isinstance(methods, str) else tuple(methods)
     if not methods:
-        raise ValueError("methods=() is not allowed: name at least one method")
+        raise _checks.fail("methods", methods, "at least one method name")
     return methods
 
 

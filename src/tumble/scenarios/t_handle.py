@@ -20,7 +20,7 @@ from functools import partial
 
 import numpy as np
 
-from tumble import exact, mass, meshes
+from tumble import _checks, exact, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, Trajectory, simulate
 from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
@@ -149,7 +149,7 @@ def run(
     """
     spins = [np.asarray(spin, dtype=float) for spin in spins]
     if not spins:
-        raise ValueError("spins=() is not allowed: give at least one initial ω (rad/s)")
+        raise _checks.fail("spins", spins, "at least one initial ω", "rad/s")
     body = RigidBody.from_mass_properties(mass.t_handle())
     runs = [_simulate(body, spin, method, h, t_end, rtol) for spin in spins]
     results = [

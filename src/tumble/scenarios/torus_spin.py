@@ -22,7 +22,7 @@ from functools import partial
 
 import numpy as np
 
-from tumble import exact, mass, meshes
+from tumble import _checks, exact, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, simulate
 from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
@@ -42,7 +42,7 @@ GRID_SPAN = 20.0
 def _methods(methods: Sequence[str] | str) -> tuple[str, ...]:
     methods = (methods,) if isinstance(methods, str) else tuple(methods)
     if not methods:
-        raise ValueError("methods=() is not allowed: name at least one method")
+        raise _checks.fail("methods", methods, "at least one method name")
     return methods
 
 

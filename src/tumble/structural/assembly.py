@@ -30,7 +30,8 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
-from tumble.structural import elements, validation
+from tumble import _checks
+from tumble.structural import elements
 from tumble.structural.factorization import factorize
 from tumble.structural.system import FrameElements, LinearSystem
 
@@ -111,7 +112,7 @@ def build_frame(
     nodes, connectivity = _checked_mesh(nodes, connectivity)
     n_nodes, n_elements = nodes.shape[0], connectivity.shape[0]
     section = {
-        name: np.broadcast_to(validation.positive(name, value, unit), (n_elements,)).astype(float)
+        name: _section(name, value, unit, n_elements)
         for name, value, unit in (
             ("E", E, "Pa"),
             ("rho", rho, "kg/m³"),
@@ -139,7 +140,7 @@ def build_frame(
     M = _assemble(elements.mass_matrices(length, cos, sin, frame.rho_A), dof_map)
     f = _nodal_loads(loads, n_nodes)[free]
     tip = _monitor_dof(monitor, position, f, n_nodes)
-    _warn_if_ill_conditioned(S)
+    _warn_if_ill_conditioned(S, supports)
     return LinearSystem(M, S, f, nodes, frame, free, tip)
 
 
@@ -195,11 +196,11 @@ def cantilever(
     >>> beam.n_dofs, round(float(beam.static_displacement()[beam.tip_dof] * 3 * 175), 9)
     (40, 1.0)
     """
-    length = float(validation.positive("length", length, "m"))
-    n_elements = validation.count("n_elements", n_elements)
-    width = validation.positive("width", width, "m")
-    height = validation.positive("height", height, "m")
-    tip_load = float(validation.finite("tip_load", tip_load, "N"))
+    length = _checks.positive("length", length, "m")
+    n_elements = _checks.count("n_elements", n_elements)
+    width = _checks.positive("width", width, "m")
+    height = _checks.positive("height", height, "m")
+    tip_load = _checks.finite("tip_load", tip_load, "N")
     x = np.linspace(0.0, length, n_elements + 1)
     nodes = np.column_stack([x, np.zeros_like(x)])
     connectivity = np.column_stack([np.arange(n_elements), np.arange(1, n_elements + 1)])
@@ -240,13 +241,15 @@ def condition_estimate(S: sp.spmatrix) -> float:
     return lam_max / lam_min
 
 
-def _warn_if_ill_conditioned(S: sp.spmatrix) -> None:
+def _warn_if_ill_conditioned(S: sp.spmatrix, supports: Mapping) -> None:
     try:
         kappa = condition_estimate(S)
     except RuntimeError as error:  # SuperLU: "Factor is exactly singular"
-        raise ValueError(
-            "supports leave a mechanism (the stiffness matrix is singular): fix enough DOFs "
-            "that no rigid motion of any part is free"
+        raise _checks.fail(
+            "supports",
+            dict(supports),
+            "supports that leave no mechanism (no rigid motion of any part free)",
+            remedy="the stiffness matrix is singular; fix more DOFs",
         ) from error
     bound = np.finfo(float).eps * kappa
     if bound > CONDITION_LIMIT:
@@ -268,10 +271,22 @@ def _assemble(blocks: NDArray, dof_map: NDArray) -> sp.csr_matrix:
     return sp.coo_matrix((blocks[keep], (rows[keep], cols[keep])), shape=(n, n)).tocsr()
 
 
+def _section(name: str, value: ArrayLike, unit: str, n_elements: int) -> NDArray:
+    """A section property [unit] per element, from one number > 0 or one per element."""
+    if np.ndim(value) == 0 and not isinstance(value, np.ndarray):
+        return np.full(n_elements, _checks.positive(name, value, unit))
+    array = _checks.array(name, value, unit=unit, positive=True)
+    if array.shape not in ((), (1,), (n_elements,)):
+        raise _checks.fail(name, value, f"a number or {n_elements} numbers, one per element", unit)
+    return np.broadcast_to(array, (n_elements,)).astype(float)
+
+
 def _checked_mesh(nodes: ArrayLike, connectivity: ArrayLike) -> tuple[NDArray, NDArray]:
-    nodes = validation.finite("nodes", nodes, "m")
+    nodes = _checks.array("nodes", nodes, unit="m")
     if nodes.ndim != 2 or nodes.shape[1] != 2 or nodes.shape[0] < 2:
-        raise ValueError(f"nodes must have shape (n_nodes >= 2, 2); got {nodes.shape}")
+        raise _checks.fail(
+            "nodes", nodes, "of shape (n_nodes >= 2, 2)", "m", f"it has shape {nodes.shape}"
+        )
     connectivity = np.asarray(connectivity)
     if (
         connectivity.ndim != 2
@@ -279,22 +294,28 @@ def _checked_mesh(nodes: ArrayLike, connectivity: ArrayLike) -> tuple[NDArray, N
         or connectivity.shape[0] < 1
         or not np.issubdtype(connectivity.dtype, np.integer)
     ):
-        raise ValueError(
-            "connectivity must be integers of shape (n_elements >= 1, 2); "
-            f"got {connectivity.dtype} {connectivity.shape}"
+        raise _checks.fail(
+            "connectivity",
+            connectivity,
+            "integers of shape (n_elements >= 1, 2)",
+            remedy=f"it has dtype {connectivity.dtype} and shape {connectivity.shape}",
         )
     if connectivity.min() < 0 or connectivity.max() >= nodes.shape[0]:
-        raise ValueError(
-            f"connectivity must hold node indices 0..{nodes.shape[0] - 1}; "
-            f"got values {connectivity.min()}..{connectivity.max()}"
+        raise _checks.fail(
+            "connectivity",
+            connectivity,
+            f"node indices 0..{nodes.shape[0] - 1}",
+            remedy=f"it holds {connectivity.min()}..{connectivity.max()}",
         )
     delta = nodes[connectivity[:, 1]] - nodes[connectivity[:, 0]]
     coincident = np.flatnonzero(np.hypot(delta[:, 0], delta[:, 1]) == 0)
     if coincident.size:
         bad = int(coincident[0])
-        raise ValueError(
-            f"connectivity row {bad} joins coincident nodes {connectivity[bad].tolist()}; "
-            "elements need length > 0"
+        raise _checks.fail(
+            f"connectivity[{bad}]",
+            connectivity[bad].tolist(),
+            "two distinct nodes",
+            remedy="it joins coincident nodes; elements need length > 0",
         )
     return nodes, connectivity.astype(np.intp)
 
@@ -304,18 +325,22 @@ def _fixed_dofs(supports: Mapping[int, str | Sequence[bool]], n_nodes: int) -> N
     for node, kind in supports.items():
         _check_node("supports", node, n_nodes)
         if isinstance(kind, str):
-            fixed[node] = SUPPORT_KINDS[
-                validation.choice(f"supports[{node}]", kind, SUPPORT_KINDS)
-            ]
+            fixed[node] = SUPPORT_KINDS[_checks.choice(f"supports[{node}]", kind, SUPPORT_KINDS)]
         elif len(kind) == 3 and all(isinstance(k, bool | np.bool_) for k in kind):
             fixed[node] = kind
         else:
-            raise ValueError(
-                f"supports[{node}] must be one of {', '.join(map(repr, SUPPORT_KINDS))} or "
-                f"three bools (u, v, θ fixed); got {kind!r}"
+            raise _checks.fail(
+                f"supports[{node}]",
+                kind,
+                f"one of {', '.join(map(repr, SUPPORT_KINDS))} or three bools (u, v, θ fixed)",
             )
     if fixed.all():
-        raise ValueError("supports fix every DOF; nothing is left to move")
+        raise _checks.fail(
+            "supports",
+            dict(supports),
+            "supports that leave some DOF free",
+            remedy="these fix every DOF; nothing is left to move",
+        )
     return fixed
 
 
@@ -323,10 +348,9 @@ def _nodal_loads(loads: Mapping[int, Sequence[float]] | None, n_nodes: int) -> N
     f = np.zeros((n_nodes, 3))
     for node, load in (loads or {}).items():
         _check_node("loads", node, n_nodes)
-        load = validation.finite(f"loads[{node}]", load, "N")
-        if load.shape != (3,):
-            raise ValueError(f"loads[{node}] must be (F_x, F_y, M_z); got {load.tolist()!r}")
-        f[node] += load
+        f[node] += _checks.array(
+            f"loads[{node}]", load, shape=(3,), unit="F_x, F_y in N, M_z in N m"
+        )
     return f.ravel()
 
 
@@ -339,10 +363,10 @@ def _monitor_dof(
     _check_node("monitor", node, n_nodes)
     index = position[3 * node + component] if component in (0, 1, 2) else -1
     if index < 0:
-        raise ValueError(f"monitor must name a free DOF (node, 0|1|2); got {monitor!r}")
+        raise _checks.fail("monitor", monitor, "a free DOF (node, component 0|1|2 for u|v|θ)")
     return int(index)
 
 
 def _check_node(name: str, node: object, n_nodes: int) -> None:
     if isinstance(node, bool) or not isinstance(node, int | np.integer) or not 0 <= node < n_nodes:
-        raise ValueError(f"{name} keys must be node indices 0..{n_nodes - 1}; got {node!r}")
+        raise _checks.fail(f"{name} key", node, f"a node index 0..{n_nodes - 1}")

@@ -58,9 +58,10 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
+from tumble import _checks
 from tumble._progress import progress_bar
 from tumble.ode.driver import Status, Stepper, march
-from tumble.structural import stepping, validation
+from tumble.structural import stepping
 from tumble.structural.factorization import MAX_BANDWIDTH, band_structure, banded_cholesky
 from tumble.structural.stepping import Increments, State
 from tumble.structural.system import LinearSystem, RayleighDamping
@@ -125,10 +126,8 @@ class Newmark:
     name: str = field(default="newmark", init=False)
 
     def __post_init__(self) -> None:
-        if not (math.isfinite(self.beta) and self.beta >= 0):
-            raise ValueError(f"beta must be a finite number >= 0; got {self.beta!r}")
-        if not (math.isfinite(self.gamma) and self.gamma > 0):
-            raise ValueError(f"gamma must be a finite number > 0; got {self.gamma!r}")
+        _checks.non_negative("beta", self.beta)
+        _checks.positive("gamma", self.gamma)
 
     def matrix(self, system: LinearSystem, C: sp.spmatrix | None, dt: float) -> sp.spmatrix:
         """The constant matrix ``M + γ Δt C + β Δt² S``."""
@@ -219,7 +218,7 @@ def resolve_scheme(scheme: str | Scheme) -> Scheme:
     """A scheme object from its name (one of :data:`SCHEMES`) or the object itself."""
     if isinstance(scheme, ThetaScheme | Newmark):
         return scheme
-    return SCHEMES[validation.choice("scheme", scheme, SCHEMES)]
+    return SCHEMES[_checks.choice("scheme", scheme, SCHEMES)]
 
 
 def integrate(
@@ -290,9 +289,9 @@ def integrate(
     'banded-cholesky'
     """
     scheme = resolve_scheme(scheme)
-    dt = validation.time_step(dt)
+    dt = _checks.positive("dt", dt, "s")
     n_steps = _step_count(n_steps, t_end, dt)
-    record_every = validation.count("record_every", record_every)
+    record_every = _checks.count("record_every", record_every)
     state = _initial_state(system, x0, y0)
     C = None if damping is None else damping.matrix(system)
     block = min(
@@ -324,10 +323,12 @@ def _choose_stepper(
     if not (structure.narrow if compiled is None else compiled):
         return stepping.ReferenceStepper(system, k, A, C), "sparse-lu"
     if structure.bandwidth > MAX_BANDWIDTH:
-        raise ValueError(
-            f"compiled=True needs a step matrix of half-bandwidth <= {MAX_BANDWIDTH}; this "
-            f"one has {structure.bandwidth} even after reverse Cuthill–McKee: leave "
-            "compiled=None to use the sparse LU"
+        raise _checks.fail(
+            "compiled",
+            compiled,
+            f"None or False for a step matrix of half-bandwidth > {MAX_BANDWIDTH}",
+            remedy=f"this one has {structure.bandwidth} even after reverse Cuthill–McKee; "
+            "leave compiled=None to use the sparse LU",
         )
     try:
         factor = banded_cholesky(A, structure.order)
@@ -339,23 +340,25 @@ def _choose_stepper(
 
 
 def _step_count(n_steps: int | None, t_end: float | None, dt: float) -> int:
-    if (n_steps is None) == (t_end is None):
-        raise ValueError(
-            f"give exactly one of n_steps and t_end; got n_steps={n_steps!r}, t_end={t_end!r}"
-        )
+    one = "give exactly one of n_steps and t_end"
+    if n_steps is None and t_end is None:
+        raise _checks.fail("n_steps", None, "an integer >= 1 when t_end is not given", remedy=one)
+    if n_steps is not None and t_end is not None:
+        raise _checks.fail("t_end", t_end, "None when n_steps is given", remedy=one)
     if n_steps is not None:
-        return validation.count("n_steps", n_steps)
-    t_end = float(validation.positive("t_end", t_end, "s"))
+        return _checks.count("n_steps", n_steps)
+    t_end = _checks.positive("t_end", t_end, "s")
     return max(1, math.ceil(t_end / dt * (1 - 1e-12)))
 
 
 def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | None) -> State:
     start = []
-    for name, value in (("x0", x0), ("y0", y0)):
-        array = np.zeros(system.n_dofs) if value is None else validation.finite(name, value)
-        if array.shape != (system.n_dofs,):
-            raise ValueError(f"{name} must have shape ({system.n_dofs},); got {array.shape}")
-        start.append(array.astype(float, copy=True))
+    shape = (system.n_dofs,)
+    for name, value, unit in (("x0", x0, "m, rad"), ("y0", y0, "m/s, rad/s")):
+        if value is None:
+            start.append(np.zeros(shape))
+        else:
+            start.append(_checks.array(name, value, shape=shape, unit=unit))
     return State.start(system, *start)
 
 

@@ -33,7 +33,7 @@ import scipy.linalg
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from tumble.structural import validation
+from tumble import _checks
 from tumble.structural.schemes import Newmark, Scheme, integrate, resolve_scheme
 from tumble.structural.system import DENSE_EIGEN_LIMIT, LinearSystem
 
@@ -160,7 +160,13 @@ def energy_scale(
     if y0 is not None:
         scale += float(system.kinetic_energy(y0))
     if not scale > 0:
-        raise ValueError("the system has no load and no initial state: nothing to measure")
+        raise _checks.fail(
+            "x0",
+            x0,
+            "non-zero (or y0 non-zero) when the system has no load",
+            "m, rad",
+            "with no load and no initial state there is nothing to measure",
+        )
     return scale
 
 
@@ -218,10 +224,8 @@ def stability_sweep(
     [True, False]
     """
     scheme = resolve_scheme(scheme)
-    dts = np.atleast_1d(np.asarray(dts, dtype=float))
-    for dt in dts:
-        validation.time_step(float(dt))
-    n_steps = validation.count("n_steps", n_steps)
+    dts = np.atleast_1d(_checks.array("dts", dts, unit="s", positive=True))
+    n_steps = _checks.count("n_steps", n_steps)
     scale = energy_scale(system, x0, y0)
     record_every = max(1, n_steps // MAX_SWEEP_RECORDS)
     growth = np.empty(dts.size)

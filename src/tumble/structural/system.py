@@ -13,7 +13,6 @@ References
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -23,7 +22,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
-from tumble.structural import elements, validation
+from tumble import _checks
+from tumble.structural import elements
 from tumble.structural.factorization import factorize
 from tumble.structural.kernels import assemble_internal_forces
 
@@ -146,8 +146,10 @@ class LinearSystem:
                [0., 3., 4.]])
         """
         x = np.asarray(x, dtype=float)
-        if x.shape[-1] != self.n_dofs:
-            raise ValueError(f"x must have {self.n_dofs} entries in its last axis; got {x.shape}")
+        if x.shape[-1:] != (self.n_dofs,):
+            raise _checks.fail(
+                "x", x, f"of shape (..., {self.n_dofs})", "m, rad", f"it has shape {x.shape}"
+            )
         full = np.zeros(x.shape[:-1] + (self.n_all_dofs,))
         full[..., self.free] = x
         return full
@@ -168,10 +170,10 @@ class LinearSystem:
         shapes : ndarray, shape (n_dofs, k)
             Mode shapes, M-orthonormal (``φᵀ M φ = 1`` [kg]).
         """
-        k = validation.count("k", k)
+        k = _checks.count("k", k)
         n = self.n_dofs
         if k > n:
-            raise ValueError(f"k must be at most n_dofs = {n}; got {k}")
+            raise _checks.fail("k", k, f"an integer from 1 to n_dofs = {n}")
         if n <= DENSE_EIGEN_LIMIT or k >= n - 1:
             inverse, shapes = scipy.linalg.eigh(
                 self.M.toarray(), self.S.toarray(), subset_by_index=(n - k, n - 1)
@@ -241,10 +243,8 @@ class RayleighDamping:
     stiffness_coefficient: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("mass_coefficient", "stiffness_coefficient"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0; got {value!r}")
+        _checks.non_negative("mass_coefficient", self.mass_coefficient, "1/s")
+        _checks.non_negative("stiffness_coefficient", self.stiffness_coefficient, "s")
 
     @classmethod
     def from_damping_ratio(cls, zeta: float, omega_1: float, omega_2: float) -> RayleighDamping:
@@ -258,11 +258,9 @@ class RayleighDamping:
         >>> round(d.mass_coefficient, 6), round(d.stiffness_coefficient, 8)
         (0.363636, 0.00036364)
         """
-        zeta = float(validation.positive("zeta", zeta))
-        w1, w2 = (
-            float(validation.positive(n, w, "rad/s"))
-            for n, w in (("omega_1", omega_1), ("omega_2", omega_2))
-        )
+        zeta = _checks.positive("zeta", zeta)
+        w1 = _checks.positive("omega_1", omega_1, "rad/s")
+        w2 = _checks.positive("omega_2", omega_2, "rad/s")
         return cls(2 * zeta * w1 * w2 / (w1 + w2), 2 * zeta / (w1 + w2))
 
     def matrix(self, system: LinearSystem) -> sp.csr_matrix:

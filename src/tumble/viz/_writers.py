@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
+from tumble import _checks
 from tumble._atomic import atomic_write
 
 FORMATS = (".gif", ".mp4")
@@ -54,9 +55,11 @@ def animation_format(path: str | Path) -> str:
     """
     suffix = Path(path).suffix.lower()
     if suffix not in FORMATS:
-        raise ValueError(
-            f"path={str(path)!r} has suffix {suffix!r}; an animation is written as one of "
-            f"{list(FORMATS)}"
+        raise _checks.fail(
+            "path",
+            str(path),
+            f"a file name ending in {' or '.join(map(repr, FORMATS))}",
+            remedy=f"its suffix is {suffix!r}",
         )
     if suffix == ".mp4" and not mp4_available():
         raise RuntimeError(
@@ -81,9 +84,9 @@ def write_animation(images: Sequence[NDArray], path: str | Path, *, fps: float =
         ``path``.
     """
     kind = animation_format(path)
-    fps = check_positive("fps", fps)
+    fps = _checks.positive("fps", fps, "frames per second")
     if len(images) == 0:
-        raise ValueError("images is empty; pass at least one frame")
+        raise _checks.fail("images", images, "at least one frame")
     path = Path(path)
     if kind == "gif":
         from PIL import Image
@@ -125,10 +128,3 @@ def _gif_palette(images: Sequence[NDArray]):
     palette = Image.new("P", (1, 1))
     palette.putpalette(cut.getpalette()[: 3 * (GIF_COLOURS - len(LOAD_COLOURS))] + reserved)
     return palette
-
-
-def check_positive(name: str, value: object) -> float:
-    """``value`` as a float; a :class:`ValueError` naming ``name`` unless it is a number > 0."""
-    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
-        raise ValueError(f"{name}={value!r} must be a positive number")
-    return float(value)

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tumble import so3
+from tumble import _checks, so3
 from tumble.rigid.forces import Force, Gravity, Impulse, State, Torque, split_loads
 from tumble.viz._figure import new_figure
 from tumble.viz._writers import (
@@ -30,7 +30,6 @@ from tumble.viz._writers import (
     GIF_COLOURS,
     LOAD_COLOURS,
     animation_format,
-    check_positive,
     mp4_available,
     write_animation,
 )
@@ -104,10 +103,10 @@ def resample(trajectory: Trajectory, frames: int) -> Frames:
     -------
     Frames
     """
-    frames = _count("frames", frames, minimum=2)
+    frames = _checks.count("frames", frames, 2)
     t = np.asarray(trajectory.t, dtype=float)
     if len(t) < 2:
-        raise ValueError(f"trajectory has {len(t)} sample(s); an animation needs at least two")
+        raise _checks.fail("trajectory.t", trajectory.t, "at least two samples", "s")
     times = np.linspace(t[0], t[-1], frames)
     k = np.clip(np.searchsorted(t, times, side="right") - 1, 0, len(t) - 2)
     span = t[k + 1] - t[k]
@@ -252,12 +251,6 @@ def _time_text(spacing: float) -> str:
     return f"t = {{:.{decimals}f}} s"
 
 
-def _count(name: str, value: object, *, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
-        raise ValueError(f"{name}={value!r} must be an integer ≥ {minimum}")
-    return int(value)
-
-
 def animate_body(
     trajectory: Trajectory,
     mesh: trimesh.Trimesh,
@@ -312,8 +305,8 @@ def animate_body(
         ``.mp4`` without ffmpeg on ``PATH``.
     """
     animation_format(path)  # refuse a bad suffix before rendering
-    fps = check_positive("fps", fps)
-    width, height = (_count("size", value, minimum=16) for value in size)
+    fps = _checks.positive("fps", fps, "frames per second")
+    width, height = (_checks.count(f"size[{i}]", value, 16) for i, value in enumerate(size))
     sampled = resample(trajectory, frames)
     vertices, faces = np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces)
     world = world_vertices(vertices, sampled.x, sampled.R)

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from tumble import _checks
 from tumble._atomic import atomic_write
 from tumble.rigid.forces import Force, Gravity, Impulse, Torque
 from tumble.viz._viewer_layout import (
@@ -252,18 +253,19 @@ def _trajectory_arrays(trajectory) -> tuple[np.ndarray, ...]:
     """``t, x, R, energy`` as float arrays, checked to describe the same n ≥ 1 samples."""
     t = np.asarray(trajectory.t, dtype=float)
     if t.ndim != 1 or len(t) == 0 or not np.all(np.isfinite(t)) or np.any(np.diff(t) < 0):
-        raise ValueError(
-            f"trajectory.t must be a non-empty, finite, non-decreasing 1-D array; got shape "
-            f"{t.shape}"
+        raise _checks.fail(
+            "trajectory.t", trajectory.t, "a non-empty, finite, non-decreasing 1-D array", "s"
         )
     n = len(t)
     arrays = [t]
     for name, shape in (("x", (n, 3)), ("R", (n, 3, 3)), ("energy", (n,))):  # energy from x, R
         array = np.asarray(getattr(trajectory, name), dtype=float)
         if array.shape != shape:
-            raise ValueError(
-                f"trajectory.{name} has shape {array.shape}; expected {shape} to match "
-                f"trajectory.t with {n} samples"
+            raise _checks.fail(
+                f"trajectory.{name}",
+                getattr(trajectory, name),
+                f"of shape {shape}, one per sample of trajectory.t",
+                remedy=f"it has shape {array.shape}",
             )
         arrays.append(array)
     return tuple(arrays)
@@ -274,19 +276,25 @@ def _mesh_arrays(mesh) -> tuple[np.ndarray, np.ndarray]:
     vertices = np.asarray(getattr(mesh, "vertices", None), dtype=float)
     faces = np.asarray(getattr(mesh, "faces", ()), dtype=np.int64)
     if vertices.ndim != 2 or vertices.shape[1:] != (3,) or len(vertices) == 0:
-        raise ValueError(f"mesh must be a trimesh.Trimesh with vertices; got {mesh!r}")
+        raise _checks.fail("mesh", mesh, "a trimesh.Trimesh with vertices")
     if faces.ndim != 2 or faces.shape[1:] != (3,) or len(faces) == 0:
-        raise ValueError(f"mesh={mesh!r} has no faces; pass a triangle mesh (trimesh.Trimesh)")
+        raise _checks.fail(
+            "mesh", mesh, "a triangle mesh (trimesh.Trimesh)", remedy="it has no faces"
+        )
     if faces.min() < 0 or faces.max() >= len(vertices):
-        raise ValueError(f"mesh={mesh!r} has faces indexing missing vertices")
+        raise _checks.fail(
+            "mesh",
+            mesh,
+            "a mesh whose faces index its vertices",
+            remedy="some faces index missing vertices",
+        )
     return vertices, faces.astype(np.int32)
 
 
 def _check_title_and_frames(title: str, frames: int) -> None:
     if not isinstance(title, str):
-        raise ValueError(f"title={title!r} must be a string")
-    if isinstance(frames, bool) or not isinstance(frames, int | np.integer) or frames < 2:
-        raise ValueError(f"frames={frames!r} must be an integer >= 2")
+        raise _checks.fail("title", title, "a string")
+    _checks.count("frames", frames, 2)
 
 
 def _impulses(loads) -> list[Impulse]:
@@ -297,9 +305,10 @@ def _impulses(loads) -> list[Impulse]:
             if np.any(load.impulse != 0):
                 impulses.append(load)
         elif not isinstance(load, Gravity | Force | Torque):
-            raise ValueError(
-                f"loads[{position}]={load!r} is not a load; use tumble.Gravity, tumble.Force, "
-                "tumble.Torque or tumble.Impulse"
+            raise _checks.fail(
+                f"loads[{position}]",
+                load,
+                "a load: tumble.Gravity, tumble.Force, tumble.Torque or tumble.Impulse",
             )
     return impulses
 

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from tumble import _checks
 from tumble.viz._figure import new_figure, save
 
 if TYPE_CHECKING:
@@ -215,12 +216,13 @@ def beam_animation(
     from tumble.viz.animation import animation_format, write_animation
 
     animation_format(path)  # refuse a bad suffix before drawing
-    if isinstance(every, bool) or not isinstance(every, int | np.integer) or every < 1:
-        raise ValueError(f"every={every!r} must be an integer ≥ 1 (records per frame)")
+    every = _checks.count("every", every)
     t, x = np.asarray(response.t)[::every], np.asarray(response.x)[::every]
     finite = np.all(np.isfinite(x), axis=1)
     if not np.any(finite):
-        raise ValueError("response has no finite record to draw")
+        raise _checks.fail(
+            "response.x", response.x, "finite in at least one record", "m, rad", response.message
+        )
     images = beam_frames(
         system, t[finite], x[finite], title=f"{title} — {response.scheme}", size=size
     )

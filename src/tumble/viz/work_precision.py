@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from tumble import _checks
 from tumble.viz._figure import new_figure, save
 
 if TYPE_CHECKING:
@@ -45,7 +46,9 @@ def draw_work_precision(points: Sequence[WorkPrecisionPoint], *, title: str) -> 
         Two axes: error against wall time (s), error against accepted steps.
     """
     if len(points) == 0:
-        raise ValueError("points is empty: pass the result of work_precision(...)")
+        raise _checks.fail(
+            "points", points, "at least one point", remedy="pass the result of work_precision(...)"
+        )
     figure, (by_time, by_steps) = new_figure(1, 2, figsize=(11, 4.6), layout="constrained")
     methods = list(dict.fromkeys(point.method for point in points))
     for index, method in enumerate(methods):
