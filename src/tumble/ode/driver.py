@@ -259,13 +259,23 @@ class Outcome:
 class _Run:
     """One run's current state, counters, record and events."""
 
-    def __init__(self, stepper, t0, state, events, record_every, max_steps, dense, progress):
+    def __init__(
+        self,
+        stepper: Stepper,
+        t0: float,
+        state: Any,
+        events: list[Event],
+        record_every: int,
+        max_steps: float,
+        dense: bool,
+        progress: Callable[[float], None] | None,
+    ):
         self.stepper, self.t, self.state = stepper, t0, state
         self.every, self.max_steps, self.progress = record_every, max_steps, progress
         self.n_steps = self.n_rejected = 0
         self.status, self.message = Status.SUCCESS, Status.SUCCESS.message
         self.tracker = EventTracker(events, t0, state) if events else None
-        self.step_times = [t0] if dense else None
+        self.step_times: list[float] | None = [t0] if dense else None
         self.interpolants: list[Callable] | None = [] if dense else None
         self.times: list[np.ndarray] = []
         self.samples: list[tuple] = []
@@ -363,6 +373,8 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
         h_min = minimum_step(t_old)
         t_new = min(t_old + max(h, h_min), t1)
         new, error = stepper.step(t_old, old, t_new - t_old)
+        if error is None:
+            raise TypeError(f"{type(stepper).__name__}.step returned no error estimate")
         scale_old, scale_new = stepper.scale(old), stepper.scale(new)
         norm = error_norm(error, scale_old, scale_new, control.rtol, control.atol)
         accepted, h = control.controller.propose(
@@ -389,7 +401,7 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
 def _blocks(run: _Run, t1: float, h: float) -> bool:
     """March the grid from ``run.t`` to ``t1`` in compiled blocks; False when it ended."""
     grid = Grid(run.t, t1, h, fixed_step_count(run.t, t1, h))
-    last = min(grid.n, run.max_steps - run.n_steps)
+    last = grid.n if run.max_steps - run.n_steps >= grid.n else int(run.max_steps) - run.n_steps
     size = max(1, grid.n // PROGRESS_BLOCKS) if run.progress is not None else grid.n
     size = min(size, run.stepper.block_steps or size)
     for k0 in range(0, last, size):

@@ -15,10 +15,9 @@ A crossing counts when ``g`` leaves a strictly non-zero sign: a ``g`` that start
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
-
-from tumble.ode.dense import StepInterpolant
 
 Event = Callable[[float, np.ndarray], float]
 _XTOL = 4 * np.finfo(float).eps
@@ -45,7 +44,7 @@ def event_attributes(event: Event, index: int) -> tuple[int, float]:
 class EventTracker:
     """Watches the events over a run and records where they fire."""
 
-    def __init__(self, events: Sequence[Event], t0: float, y0: np.ndarray):
+    def __init__(self, events: Sequence[Event], t0: float, y0: Any):
         for index, event in enumerate(events):
             if not callable(event):
                 raise ValueError(f"events[{index}]={event!r} is not callable g(t, y) -> float")
@@ -83,7 +82,7 @@ class EventTracker:
         return float(brentq(g, t_old, t_new, xtol=_XTOL, rtol=_XTOL))
 
     def update(
-        self, t_old: float, t_new: float, y_new: np.ndarray, sol: StepInterpolant
+        self, t_old: float, t_new: float, y_new: Any, sol: Callable[[float], Any]
     ) -> float | None:
         """Locate the crossings in ``[t_old, t_new]``; return a terminal event's time or None."""
         g_new = self._values(t_new, y_new)
