@@ -50,7 +50,11 @@ def fail(name: str, value: object, allowed: str, unit: str = "", remedy: str = "
 
 def _finite_real(value: object) -> float | None:
     """``value`` as a float if it is a finite real number (not a bool), else None."""
-    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+    if isinstance(value, bool):
+        return None
+    if isinstance(value, float | int | np.floating | np.integer) or isinstance(
+        value, numbers.Real
+    ):
         number = float(value)
         if math.isfinite(number):
             return number

@@ -67,7 +67,6 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from tumble import _checks
 from tumble.ode.control import (
     StepController,
     error_norm,
@@ -486,7 +485,9 @@ def march(
     ([0.0, 0.5, 1.0], [1.0, 0.5625, 0.31640625], <Status.SUCCESS: 0>)
     """
     t0, t1 = t_span
-    step = _checks.positive("h", h)  # the caller chose it (a first step when adaptive)
+    if h is None:  # the caller chooses it (a first step when adaptive) and checks it
+        raise TypeError("march needs h: the fixed step, or an adaptive run's first step")
+    step = float(h)
     limit = math.inf if max_steps is None else max_steps
     run = _Run(stepper, t0, state, list(events), record_every, limit, dense_output, progress)
     compiled = stepper.blocks and control is None and not events and not dense_output
