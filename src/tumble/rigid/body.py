@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -40,7 +41,7 @@ class RigidBody:
     """
 
     mass: float
-    inertia: np.ndarray
+    inertia: Any  # array_like, shape (3, 3) or (3,) given; a read-only (3, 3) ndarray after
     allow_unphysical: bool = False
     inertia_inverse: np.ndarray = field(init=False, repr=False)
 

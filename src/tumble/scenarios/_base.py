@@ -45,7 +45,9 @@ def rigid_animations(
     frames = animation_frames(trajectory)
 
     # a run stopped by overflow ends in huge, non-rotation matrices: draw them quietly
-    quiet = {"over": "ignore", "invalid": "ignore"} if trajectory.status < 0 else {}
+    quiet: dict[str, Any] = (
+        {"over": "ignore", "invalid": "ignore"} if trajectory.status < 0 else {}
+    )
 
     def gif(path: Path) -> None:
         from tumble.viz.animation import animate_body

@@ -50,6 +50,7 @@ from pydantic import (
 )
 
 from tumble import mass, meshes
+from tumble.mass import MassProperties
 from tumble.scenarios.schema import (
     Matrix3,
     Positive,
@@ -90,6 +91,8 @@ class _Solid(Section):
 
     dimensions: ClassVar[tuple[str, ...]] = ()
     placement: ClassVar[tuple[str, ...]] = ("axis", "center")
+    if TYPE_CHECKING:  # each primitive declares its own Literal
+        shape: str
     density: Positive | None = None
     mass: Positive | None = None
     center: Vector3 = [0.0, 0.0, 0.0]
@@ -111,7 +114,7 @@ class _Solid(Section):
         sizes = [getattr(self, name) for name in self.dimensions]
         return sizes, {name: getattr(self, name) for name in self.placement}
 
-    def mass_properties(self) -> mass.MassProperties:
+    def mass_properties(self) -> MassProperties:
         """Mass, centre of mass (m) and inertia (kg m²) in the description's coordinates."""
         sizes, placement = self._arguments()
         build = getattr(mass, self.shape)
@@ -219,7 +222,7 @@ class MeshBody(Section):
     def surface(self) -> trimesh.Trimesh:
         return meshes.load(self.mesh).apply_scale(self.scale)
 
-    def mass_properties(self) -> mass.MassProperties:
+    def mass_properties(self) -> MassProperties:
         return meshes.from_mesh(self.surface(), density=self.density)
 
     def label(self) -> str:
@@ -246,10 +249,13 @@ def _union(members: dict[str, Any], message: str) -> Any:
     ]
 
 
-Part = _union(
-    {"<primitive>": Primitive, "<mesh>": MeshBody},
-    "each part needs a shape (cylinder, box, sphere, torus, hex_prism) or a mesh file",
-)
+if TYPE_CHECKING:  # what _union builds at run time: a tagged union with its own message
+    Part = Cylinder | Box | Sphere | Torus | HexPrism | MeshBody
+else:
+    Part = _union(
+        {"<primitive>": Primitive, "<mesh>": MeshBody},
+        "each part needs a shape (cylinder, box, sphere, torus, hex_prism) or a mesh file",
+    )
 
 
 class Composite(Section):
@@ -272,13 +278,14 @@ class Composite(Section):
             data = {**data, "parts": parts}
         return data
 
-    def mass_properties(self) -> mass.MassProperties:
-        return sum(part.mass_properties() for part in self.parts)
+    def mass_properties(self) -> MassProperties:
+        first, *rest = (part.mass_properties() for part in self.parts)
+        return sum(rest, first)
 
     def surface(self) -> trimesh.Trimesh:
         import trimesh
 
-        return trimesh.util.concatenate([part.surface() for part in self.parts])
+        return trimesh.util.concatenate([part.surface() for part in self.parts])  # type: ignore[return-value]  # trimesh annotates Geometry
 
     def label(self) -> str:
         return "composite (" + " + ".join(part.label() for part in self.parts) + ")"

@@ -101,7 +101,7 @@ def run(
 
 
 def _best(rows: list[dict]) -> dict:
-    best = {}
+    best: dict[str, dict] = {}
     for row in rows:
         if not np.isfinite(row["error"]):
             continue

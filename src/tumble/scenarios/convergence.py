@@ -26,6 +26,7 @@ from collections.abc import Sequence
 from functools import partial
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from tumble import _checks, exact
 from tumble.io import ScenarioResult
@@ -67,7 +68,7 @@ FIXED_STEP_METHODS = tuple(name for name, method in METHODS.items() if not metho
 """The methods that have an observed order in h: every method with a fixed step."""
 
 
-def final_errors(method: str, step_sizes: Sequence[float], *, t_end: float = 10.0) -> np.ndarray:
+def final_errors(method: str, step_sizes: ArrayLike, *, t_end: float = 10.0) -> np.ndarray:
     """``‖R(T) − R_exact(T)‖_F`` of ``method`` on the test body at each step size.
 
     Parameters
@@ -99,7 +100,7 @@ def final_errors(method: str, step_sizes: Sequence[float], *, t_end: float = 10.
     body = RigidBody(1.0, INERTIA, allow_unphysical=True)
     reference = exact.free_body_rotation(INERTIA, body.inertia_inverse @ L0, t_end)
     errors = []
-    for h in step_sizes:
+    for h in np.asarray(step_sizes, dtype=float).tolist():
         steps = max(1, round(t_end / h))
         run = simulate(body, t_end, method=method, h=h, L0=L0, record_every=steps)
         errors.append(np.linalg.norm(run.R[-1] - reference))
@@ -187,8 +188,8 @@ def _dataset(step_sizes: np.ndarray, results: dict):
 
     methods = list(results)
     errors = np.array([results[method]["errors"] for method in methods])
-    orders = [results[method]["observed_order"] for method in methods]
-    orders = np.array([np.nan if order is None else order for order in orders], dtype=float)
+    observed = [results[method]["observed_order"] for method in methods]
+    orders = np.array([np.nan if order is None else order for order in observed], dtype=float)
     return xr.Dataset(
         {
             "error": (("method", "h"), errors, {"units": "1", "long_name": "|R(T) − R_exact|_F"}),

@@ -137,7 +137,7 @@ def _field_type(annotation: Any, default: Any, vector: bool = False) -> Any:
         return result | None if optional else result
     if origin in (list, tuple, Sequence) and args:
         item = _field_type(args[0], None, vector)
-        return Vector3 if vector and item is Number else list[item]
+        return Vector3 if vector and item is Number else list[item]  # type: ignore[valid-type]
     return Any
 
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
-from typing import Annotated, Any, ClassVar
+from typing import Annotated, Any, ClassVar, TypeVar
 
 import numpy as np
 from pydantic import (
@@ -259,13 +259,16 @@ def error_lines(error: ValidationError, data: Any, prefix: str = "") -> list[str
     return lines
 
 
+Model = TypeVar("Model", bound=BaseModel)
+
+
 def validate(
-    model: type[BaseModel],
+    model: type[Model],
     data: Any,
     *,
     prefix: str = "",
     folder: Path | None = None,
-) -> BaseModel:
+) -> Model:
     """``model.model_validate(data)``, with a :class:`ValueError` naming every bad key.
 
     Parameters

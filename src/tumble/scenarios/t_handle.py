@@ -147,13 +147,13 @@ def run(
     >>> abs(spin["period_measured"] / spin["period_closed_form"] - 1) < 1e-6
     True
     """
-    spins = [np.asarray(spin, dtype=float) for spin in spins]
-    if not spins:
+    omegas = [np.asarray(spin, dtype=float) for spin in spins]
+    if not omegas:
         raise _checks.fail("spins", spins, "at least one initial ω", "rad/s")
     body = RigidBody.from_mass_properties(mass.t_handle())
-    runs = [_simulate(body, spin, method, h, t_end, rtol) for spin in spins]
+    runs = [_simulate(body, spin, method, h, t_end, rtol) for spin in omegas]
     results = [
-        _spin_result(body, spin, trajectory) for spin, trajectory in zip(spins, runs, strict=True)
+        _spin_result(body, spin, trajectory) for spin, trajectory in zip(omegas, runs, strict=True)
     ]
     summary = {
         "scenario": NAME,

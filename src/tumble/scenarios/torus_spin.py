@@ -140,7 +140,7 @@ def precession_rate(inertia: np.ndarray, omega0: Sequence[float]) -> float:
     return float((perpendicular - symmetric) * omega0[2] / perpendicular)
 
 
-def _number(value: float) -> float | None:
+def _number(value: float | np.floating) -> float | None:
     """A float for JSON, or None where the run overflowed (JSON has no inf or nan)."""
     return float(value) if np.isfinite(value) else None
 
