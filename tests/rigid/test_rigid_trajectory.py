@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from tumble import so3
-from tumble.rigid import RigidBody, simulate
+from tumble.rigid import Gravity, RigidBody, Trajectory, simulate
 
 
 @pytest.fixture(scope="module")
@@ -34,3 +34,68 @@ def test_xarray_dataset_carries_dimensions_units_and_settings(run):
     assert ds.attrs["method"] == "rkmk4"
     np.testing.assert_array_equal(ds["time"].values, run.t)
     np.testing.assert_array_equal(ds["energy"].values, run.energy)
+
+
+def _trajectory(body, *, v=None, L_world=None, R=None):
+    """A three-sample trajectory built by hand (the fields not given are at rest, R = Id)."""
+    n = 3
+    return Trajectory(
+        t=np.arange(n, dtype=float),
+        x=np.zeros((n, 3)),
+        v=np.zeros((n, 3)) if v is None else np.asarray(v, dtype=float),
+        R=np.tile(np.eye(3), (n, 1, 1)) if R is None else np.asarray(R, dtype=float),
+        L_world=np.zeros((n, 3)) if L_world is None else np.asarray(L_world, dtype=float),
+        body=body,
+        method="by hand",
+    )
+
+
+def test_energy_error_and_drift_by_hand():
+    # Translation only: E = ½ m |v|² = 1, 1.21, 0.81 J for m = 2 kg.
+    run = _trajectory(RigidBody(2.0, [1.0, 2.0, 2.5]), v=[[1, 0, 0], [1.1, 0, 0], [0.9, 0, 0]])
+    np.testing.assert_allclose(run.energy_error, [0.0, 0.21, -0.19], atol=1e-15)
+    assert run.energy_drift == pytest.approx(0.21, rel=1e-14)  # max |E − E₀| / |E₀|
+
+
+def test_momentum_error_and_drift_by_hand():
+    run = _trajectory(
+        RigidBody(2.0, [1.0, 2.0, 2.5]), L_world=[[2, 0, 0], [2, 0.3, 0], [2, 0, -0.4]]
+    )
+    np.testing.assert_allclose(run.momentum_error, [0.0, 0.3, 0.4], atol=1e-15)
+    assert run.momentum_drift == pytest.approx(0.4 / 2.0, rel=1e-14)  # max ‖L − L₀‖ / ‖L₀‖
+
+
+def test_orthogonality_drift_by_hand():
+    stretched = np.diag([1.0, 1.0, 1.1])  # RᵀR − I = diag(0, 0, 0.21)
+    run = _trajectory(RigidBody(1.0, [1.0, 1.0, 1.0]), R=[np.eye(3), stretched, np.eye(3)])
+    assert run.orthogonality_drift == pytest.approx(0.21, rel=1e-14)
+
+
+def test_drifts_relative_to_a_zero_reference_are_nan():
+    run = _trajectory(RigidBody(1.0, [1.0, 1.0, 1.0]), v=[[0, 0, 0], [1, 0, 0], [0, 0, 0]])
+    assert np.isnan(run.energy_drift) and np.isnan(run.momentum_drift)
+    np.testing.assert_array_equal(run.energy_error, [0.0, 0.5, 0.0])  # the change is still J
+
+
+def test_euler_on_the_sphere_drifts_off_so3_by_the_closed_form():
+    # I = Id, ω = (1, 0, 0): explicit Euler keeps R's first row and column (1, 0, 0) and
+    # multiplies its yz block by a rotation times √(1 + h²) per step, so RᵀR − I =
+    # diag(0, g, g) with g = (1 + h²)^k − 1, while ω = Rᵀ L and the energy stay exact.
+    run = simulate(RigidBody(1.0, np.eye(3)), 1.0, method="euler", h=0.1, omega0=(1, 0, 0))
+    assert run.orthogonality_drift == pytest.approx(np.sqrt(2) * (1.01**10 - 1), rel=1e-12)
+    assert run.energy_drift == 0.0 and run.momentum_drift == 0.0
+
+
+def test_energy_error_under_gravity_is_the_closed_form():
+    # Kinetic energy only: E − E₀ = m (v₀·g t + ½ |g|² t²); RK4 steps the linear v exactly.
+    g, v0, body = np.array([0.0, 0.0, -9.81]), np.array([3.0, 0.0, 4.0]), RigidBody(2.0, np.eye(3))
+    run = simulate(body, 1.0, h=0.1, v0=v0, forces=[Gravity(g)])
+    expected = 2.0 * (v0 @ g * run.t + 0.5 * (g @ g) * run.t**2)
+    np.testing.assert_allclose(run.energy_error, expected, rtol=1e-13, atol=1e-13)
+    assert run.energy_drift == pytest.approx(np.abs(expected).max() / 25.0, rel=1e-13)
+
+
+def test_lie_euler_on_the_sphere_keeps_every_invariant():
+    run = simulate(RigidBody(1.0, np.eye(3)), 1.0, method="lie-euler", h=0.1, omega0=(1, 0, 0))
+    assert run.energy_drift < 1e-15 and run.orthogonality_drift < 1e-15
+    assert run.momentum_drift == 0.0

@@ -43,6 +43,15 @@ class Trajectory:
         For each event, the times at which it fired.
     q_raw : ndarray, shape (n, 4), optional
         The quaternions the ``quat`` method carried (otherwise ``q`` comes from ``R``).
+
+    Notes
+    -----
+    The diagnostics are computed from these on first use: ``omega_body``, ``q``, ``energy``;
+    along the run ``orthogonality_error`` (``‖RᵀR − I‖_F``), ``quaternion_norm_error``,
+    ``energy_error`` (``E − E₀``) and ``momentum_error`` (``‖L − L₀‖``); and over the run
+    ``orthogonality_drift``, ``energy_drift`` and ``momentum_drift`` (the largest of each,
+    the last two relative to ``E₀`` and ``‖L₀‖``). The scenarios' summaries and the drift
+    plot report these.
     """
 
     t: np.ndarray
@@ -98,6 +107,50 @@ class Trajectory:
             return np.linalg.norm(defect, axis=(1, 2))
 
     @cached_property
+    def energy_error(self) -> np.ndarray:
+        """``E − E₀``, shape (n,), J: the kinetic energy's change since the first sample."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            return self.energy - self.energy[0]
+
+    @cached_property
+    def momentum_error(self) -> np.ndarray:
+        """``‖L − L₀‖``, shape (n,), kg m²/s: how far the world angular momentum has moved."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            return np.linalg.norm(self.L_world - self.L_world[0], axis=1)
+
+    @property
+    def energy_drift(self) -> float:
+        """Largest relative energy change over the run, ``max_k |E_k − E₀| / |E₀|``.
+
+        The same as ``max_k |E_k/E₀ − 1|``. NaN when ``E₀ = 0`` (a body at rest has no
+        relative drift); inf or NaN when the run diverged. Without loads after ``t₀`` the
+        energy is an invariant, so this measures the method's error.
+
+        Examples
+        --------
+        >>> from tumble.rigid import RigidBody, simulate
+        >>> body = RigidBody(1.0, [1.0, 2.0, 3.0])
+        >>> lie = simulate(body, 10.0, method="lie-euler", h=0.1, omega0=[0.1, 1.0, 0.1])
+        >>> round(lie.energy_drift, 4), lie.momentum_drift  # first order; L kept exactly
+        (0.124, 0.0)
+        """
+        return _relative_drift(np.abs(self.energy_error), abs(self.energy[0]))
+
+    @property
+    def momentum_drift(self) -> float:
+        """Largest relative change of the world angular momentum, ``max_k ‖L_k − L₀‖ / ‖L₀‖``.
+
+        NaN when ``L₀ = 0``. Every method steps ``L̇ = τ`` with its tableau, so without torque
+        this is 0 exactly (see :attr:`tumble.rigid.Method.conserves`).
+        """
+        return _relative_drift(self.momentum_error, float(np.linalg.norm(self.L_world[0])))
+
+    @property
+    def orthogonality_drift(self) -> float:
+        """Largest ``‖RᵀR − I‖_F`` over the run (0 for an exact rotation)."""
+        return float(np.max(self.orthogonality_error))
+
+    @cached_property
     def quaternion_norm_error(self) -> np.ndarray:
         """``|q| − 1`` of the carried quaternions (zeros for the other families), shape (n,)."""
         if self.q_raw is None:
@@ -131,3 +184,11 @@ class Trajectory:
         from tumble.rigid._xarray import trajectory_from_dataset
 
         return trajectory_from_dataset(dataset)
+
+
+def _relative_drift(errors: np.ndarray, scale: float) -> float:
+    """``max(errors) / scale``, or NaN when the reference ``scale`` is 0 or not finite."""
+    if scale == 0.0 or not np.isfinite(scale):
+        return float("nan")
+    with np.errstate(over="ignore", invalid="ignore"):
+        return float(np.max(errors) / scale)
