@@ -106,7 +106,7 @@ INFINITE = {
     "mass properties mass": (lambda: mass.MassProperties(INF, np.zeros(3), np.eye(3)), "mass"),
     "cylinder mass": (lambda: mass.cylinder(1.0, 1.0, mass=INF), "mass"),
     "cylinder density": (lambda: mass.cylinder(1.0, 1.0, density=INF), "density"),
-    "mesh density": (lambda: meshes.from_mesh(meshes.box([1.0, 1.0, 1.0]), density=INF), "density"),
+    "mesh density": (lambda: meshes.from_mesh(meshes.box([1, 1, 1]), density=INF), "density"),
     "beam density": (lambda: _beam(rho=INF), "rho"),
     "integrate dt": (lambda: structural.integrate(_beam(), "midpoint", INF, n_steps=1), "dt"),
     "sweep dt": (lambda: structural.stability_sweep(_beam(), "midpoint", [INF], 1), "dts[0]"),

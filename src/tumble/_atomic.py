@@ -5,10 +5,11 @@ from __future__ import annotations
 import os
 import tempfile
 from collections.abc import Callable
+from os import PathLike
 from pathlib import Path
 
 
-def atomic_write(path: str | Path, writer: Callable[[Path], None]) -> Path:
+def atomic_write(path: str | PathLike[str], writer: Callable[[Path], object]) -> Path:
     """Call ``writer(tmp)`` on a temporary sibling of ``path``, then rename it to ``path``.
 
     The temporary file (``.NAME.XXXX.partial.SUFFIX`` in the same folder, unique per call, so

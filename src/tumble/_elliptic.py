@@ -73,7 +73,7 @@ def jacobi(u: np.ndarray, m: float, m1: float) -> tuple[np.ndarray, ...]:
     Accurate for |u| ≤ K(m); ``dn = √(cn² + m1 sn²)`` avoids the cancellation in 1 − m sn².
     """
     a, b, c = 1.0, np.sqrt(m1), np.sqrt(m)
-    ratios = []
+    ratios: list[float] = []
     while c > AGM_TOL * a and len(ratios) < AGM_MAX_STEPS:
         a, b, c = 0.5 * (a + b), np.sqrt(a * b), 0.5 * (a - b)
         ratios.append(c / a)
@@ -274,7 +274,7 @@ def elliptic_rotation(
     momenta = moments[order] * np.vstack([motion.omega(np.zeros(1)), motion.omega(t)])[:, order]
     norm = np.linalg.norm(momenta[0])
     frames = pole_frames(momenta / norm)
-    phi = motion.precession(t, norm)
+    phi = motion.precession(t, float(norm))
     c, s = np.cos(phi), np.sin(phi)
     spin = np.zeros((t.size, 3, 3))
     spin[:, 0, 0], spin[:, 0, 1], spin[:, 1, 0], spin[:, 1, 1], spin[:, 2, 2] = c, -s, s, c, 1.0

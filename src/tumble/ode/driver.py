@@ -176,6 +176,10 @@ class Stepper:
     block_steps: int | None = None
     """At most this many steps per :meth:`march_block` call (None: the whole grid)."""
 
+    def start(self, state: Any) -> Any:
+        """The stepped state for a caller's initial state (by default the same object)."""
+        return state
+
     def step(self, t: float, state: Any, h: float) -> tuple[Any, np.ndarray | None]:
         raise NotImplementedError
 

@@ -447,7 +447,9 @@ class BatchStepper(Stepper):
         self._quat = self.chart.name == "quat"
         self.counts = self.failed = np.zeros(0, dtype=np.int64)
 
-    def start(self, R: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def start(self, state: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
+        """The stepped state for ``(R, Y)`` with a leading body axis."""
+        R, Y = state
         return self.chart.attitude(R), Y
 
     def record(self, state) -> tuple:
@@ -489,7 +491,7 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
     problem = Problem(spec.dexpinv, tableau.A, tableau.b, inv_I, mass, F, tau, points,
                       point_forces)  # fmt: skip
     stepper = BatchStepper(spec, problem)
-    out = march(stepper, (t0, t_end), stepper.start(R, Y), h=h, record_every=every)
+    out = march(stepper, (t0, t_end), stepper.start((R, Y)), h=h, record_every=every)
     names = ("R", "Y", "q") if spec.family == "quat" else ("R", "Y")
     samples = dict(zip(names, out.records, strict=False))
     last = {

@@ -10,9 +10,8 @@ Each load's ``__call__(t, state, mass)`` returns ``(F, τ)``; ``state`` is a :cl
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -41,7 +40,12 @@ class State(NamedTuple):
     L: np.ndarray
 
 
-VectorOrCallable = ArrayLike | Callable[[float, State], ArrayLike]
+Vector = Any
+"""array_like, shape (3,), when a load is made; a read-only float ndarray (3,) once it is
+(``__post_init__`` converts and checks it)."""
+
+VectorOrCallable = Any
+"""A :data:`Vector`, or a callable ``f(t, state) -> array_like (3,)`` (kept as it is)."""
 _ZERO = np.zeros(3)
 
 
@@ -72,7 +76,7 @@ class Gravity:
         Gravitational acceleration (m/s², world); default ``(0, 0, -9.81)``.
     """
 
-    g: ArrayLike = (0.0, 0.0, -9.81)
+    g: Vector = (0.0, 0.0, -9.81)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "g", _vector(self.g, "g", "m/s²"))
@@ -98,7 +102,7 @@ class Force:
     """
 
     force: VectorOrCallable
-    point: ArrayLike | None = None
+    point: Vector | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "force", _vector_or_callable(self.force, "force", "N"))
@@ -151,8 +155,8 @@ class Impulse:
         When (s); the integration lands a step on it.
     """
 
-    point: ArrayLike
-    impulse: ArrayLike
+    point: Vector
+    impulse: Vector
     time: float = 0.0
 
     def __post_init__(self) -> None:

@@ -162,7 +162,7 @@ def simulate(
         "record_every": record_every,
         "compiled": use_kernel,
     }
-    state = stepper.start(R, Y)
+    state = stepper.start((R, Y))
     jumps = _jumps(stepper, impulses, t0, t_end)
     control = None
     if spec.adaptive:

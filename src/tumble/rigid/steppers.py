@@ -37,8 +37,9 @@ class RigidStepper(Stepper):
         self._chart_scale = np.ones(self.chart.size)  # chart errors measured against 1
         self._quat = self.chart.name == "quat"
 
-    def start(self, R: np.ndarray, Y: np.ndarray) -> RigidState:
-        """The stepped state for the attitude ``R`` and ``Y = (x, p, L)``."""
+    def start(self, state: tuple[np.ndarray, np.ndarray]) -> RigidState:
+        """The stepped state for ``(R, Y)``: the attitude matrix and ``Y = (x, p, L)``."""
+        R, Y = state
         return self.chart.attitude(R), Y
 
     def step(self, t: float, state: RigidState, h: float) -> tuple[RigidState, np.ndarray | None]:

@@ -237,7 +237,7 @@ def condition_estimate(S: sp.spmatrix) -> float:
     v = np.random.default_rng(0).standard_normal(S.shape[0])
     for _ in range(INVERSE_ITERATIONS):
         v = solve(v / np.linalg.norm(v))
-    lam_min = 1.0 / np.linalg.norm(v)
+    lam_min = 1.0 / float(np.linalg.norm(v))
     return lam_max / lam_min
 
 

@@ -215,6 +215,7 @@ def run_steps(
     diverged : int
         The step at which the state became non-finite (recorded, and the run stops), or -1.
     """
+    # The type: ignore[call-arg] below: numba's stubs count a *tuple into a Dispatcher wrongly.
     dt, k_g, k_dy, k_sa, k_a = coefficients
     use_mass = k_sa != 0.0 or k_a != 0.0
     x, y, q, g = state
@@ -236,7 +237,7 @@ def run_steps(
         if use_mass:  # a = M⁻¹ r
             a[:] = rhs
             banded_solve(mass_factor[0], mass_factor[1], mass_factor[2], a, mass_factor[3])
-            assemble_internal_forces(a, *frame, sa)
+            assemble_internal_forces(a, *frame, sa)  # type: ignore[call-arg]
             for i in range(n):
                 rhs[i] -= k_sa * sa[i]
         for i in range(n):
@@ -252,9 +253,10 @@ def run_steps(
             rhs[i] = dx
             non_finite += not (np.isfinite(x[i]) and np.isfinite(y[i]))
         if k_g != 0.0:
-            assemble_internal_forces_pair(rhs, y, *frame, h, g)  # h = S Δx, g = S y
+            # h = S Δx, g = S y
+            assemble_internal_forces_pair(rhs, y, *frame, h, g)  # type: ignore[call-arg]
         else:
-            assemble_internal_forces(rhs, *frame, h)
+            assemble_internal_forces(rhs, *frame, h)  # type: ignore[call-arg]
         if non_finite or k == record_steps[row]:
             xs[row] = x
             ys[row] = y

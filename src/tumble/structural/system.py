@@ -75,7 +75,7 @@ class FrameElements:
         """``S x`` [N, N m] summed element by element (compiled kernel), shape (n_dofs,)."""
         x = np.ascontiguousarray(x, dtype=float)
         out = np.empty_like(x) if out is None else out
-        assemble_internal_forces(x, *self.kernel_arrays, out)
+        assemble_internal_forces(x, *self.kernel_arrays, out)  # type: ignore[call-arg]  # numba's stub
         return out
 
     def strain_energy(self, x: ArrayLike) -> NDArray:

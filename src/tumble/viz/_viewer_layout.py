@@ -91,11 +91,11 @@ def style_now(line, marker) -> tuple:
 
 def apply_layout(fig, title: str, times, world: np.ndarray, arrows, energy_range) -> None:
     """Title, equal-aspect 3D axes over the whole run, the energy axes, sizes."""
-    points = [world.reshape(-1, 3)]
+    parts = [world.reshape(-1, 3)]
     for line, cone in arrows:
-        points += [np.column_stack([line["x"], line["y"], line["z"]])]
-        points += [np.column_stack([cone["x"], cone["y"], cone["z"]])]
-    points = np.concatenate(points)
+        parts += [np.column_stack([line["x"], line["y"], line["z"]])]
+        parts += [np.column_stack([cone["x"], cone["y"], cone["z"]])]
+    points = np.concatenate(parts)
     points = points[np.all(np.isfinite(points), axis=1)]
     if len(points) == 0:
         points = np.zeros((1, 3))

@@ -126,5 +126,6 @@ def _gif_palette(images: Sequence[NDArray]):
     reserved = [round(255 * c) for colour in LOAD_COLOURS.values() for c in to_rgb(colour)]
     cut = mosaic.quantize(GIF_COLOURS - len(LOAD_COLOURS), dither=Image.Dither.NONE)
     palette = Image.new("P", (1, 1))
-    palette.putpalette(cut.getpalette()[: 3 * (GIF_COLOURS - len(LOAD_COLOURS))] + reserved)
+    colours = cut.getpalette() or []  # a quantized image always has one
+    palette.putpalette(colours[: 3 * (GIF_COLOURS - len(LOAD_COLOURS))] + reserved)
     return palette

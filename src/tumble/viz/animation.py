@@ -224,8 +224,8 @@ def _caption(loads: Sequence[object]) -> str:
     lines = []
     for load in loads:
         if isinstance(load, Impulse):
-            size = np.linalg.norm(load.impulse)
-            lines.append(f"red: impulse |J| = {size:.3g} N s at t = {load.time:g} s")
+            magnitude = np.linalg.norm(load.impulse)
+            lines.append(f"red: impulse |J| = {magnitude:.3g} N s at t = {load.time:g} s")
         elif isinstance(load, Force):
             size = (
                 "F(t, state)"

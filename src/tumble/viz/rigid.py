@@ -18,10 +18,14 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from tumble.viz._figure import new_figure, save
+
+if TYPE_CHECKING:
+    from tumble.rigid.trajectory import Trajectory
 
 LOG_FLOOR = 1e-17
 """Smallest value drawn on a log axis; smaller ones (and zeros) are drawn here."""
@@ -156,7 +160,7 @@ def _drift_series(run) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return energy, momentum, orthogonality
 
 
-def drift(runs: Sequence[tuple[str, object]], path: str | Path, *, title: str) -> None:
+def drift(runs: Sequence[tuple[str, Trajectory]], path: str | Path, *, title: str) -> None:
     """What each method fails to conserve: energy, angular momentum, orthogonality of R.
 
     Three panels on log axes against time: ``|E − E₀|/E₀``, ``|L − L₀|/|L₀|`` (world

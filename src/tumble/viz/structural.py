@@ -170,7 +170,7 @@ def beam_frames(
         axes.set_title(f"{title}, t = {time:.4f} s", fontsize=10)
         figure.canvas.draw()
         figure.set_layout_engine("none")  # same labels every frame: keep the first layout
-        frames.append(np.asarray(figure.canvas.buffer_rgba())[..., :3].copy())
+        frames.append(np.asarray(figure.canvas.buffer_rgba())[..., :3].copy())  # type: ignore[attr-defined]  # Agg canvas
     return frames
 
 
@@ -243,5 +243,5 @@ def _draw_frame(
     from matplotlib.collections import LineCollection
 
     segments = position[system.elements.connectivity]  # (n_elements, 2 ends, 2 coordinates)
-    axes.add_collection(LineCollection(segments, colors=[colour], **style))
+    axes.add_collection(LineCollection(list(segments), colors=[colour], **style))
     axes.autoscale_view()
