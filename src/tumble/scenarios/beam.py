@@ -18,6 +18,7 @@ import numpy as np
 
 from tumble import _checks, structural
 from tumble.io import ScenarioResult
+from tumble.scenarios._common import json_number
 from tumble.viz import structural as viz
 
 NAME = "beam"
@@ -168,7 +169,7 @@ def _summary(settings, beam, omega, dt, critical, runs, sweeps, scale) -> dict[s
         "sweep": {
             sweep.scheme: {
                 "dt": sweep.dt.tolist(),
-                "energy_growth": [_number(g) for g in sweep.energy_growth],
+                "energy_growth": [json_number(g) for g in sweep.energy_growth],
                 "stable": sweep.stable.tolist(),
             }
             for sweep in sweeps
@@ -184,10 +185,10 @@ def _scheme_summary(response, scale: float, static_tip: float) -> dict[str, Any]
     return {
         "status": response.status,
         "message": response.message,
-        "energy_change_max": _number(np.max(np.abs(change))),
-        "energy_change_final": _number(change[-1]),
-        "tip_mean_over_static": _number(tip.mean()) if response.success else None,
-        "tip_max_over_static": _number(tip.max()) if response.success else None,
+        "energy_change_max": json_number(np.max(np.abs(change))),
+        "energy_change_final": json_number(change[-1]),
+        "tip_mean_over_static": json_number(tip.mean()) if response.success else None,
+        "tip_max_over_static": json_number(tip.max()) if response.success else None,
     }
 
 
@@ -223,11 +224,6 @@ def _figures(beam, runs, sweeps, scale, every) -> list:
         )
     )
     return figures
-
-
-def _number(value: float) -> float | None:
-    """JSON has no inf or NaN: those become None."""
-    return float(value) if np.isfinite(value) else None
 
 
 def stability(
@@ -276,7 +272,7 @@ def stability(
         "dt": dts.tolist(),
         "schemes": {
             sweep.scheme: {
-                "energy_growth": [_number(g) for g in sweep.energy_growth],
+                "energy_growth": [json_number(g) for g in sweep.energy_growth],
                 "stable": sweep.stable.tolist(),
             }
             for sweep in sweeps

@@ -31,24 +31,19 @@ from numpy.typing import ArrayLike
 from tumble import _checks, exact
 from tumble.io import ScenarioResult
 from tumble.rigid import METHODS, RigidBody, simulate
+from tumble.scenarios._common import fixed_step_methods, method_names
 from tumble.viz import rigid
 
 NAME = "convergence"
 SUMMARY = "Observed order of each method on the body diag(2, 1, 2/3); seed 002's RK4 is order 2."
 
-CLAIMED_ORDERS = {
-    "euler": 1,
-    "lie-euler": 1,
-    "rk4-matrix": 4,
-    "rk4-quat": 4,
-    "seed-rk4": 2,
-    "rkmk4": 4,
-    "rkmk8": 8,
-}
-"""The order each fixed-step method should show."""
-DEFAULT_METHODS = tuple(method for method in CLAIMED_ORDERS if method != "rkmk8")
-"""The methods studied by default: ``rkmk8`` reaches round-off (about 1e-15) at the default
-steps; it shows its order with ``step_counts=HIGH_ORDER_STEP_COUNTS``."""
+CLAIMED_ORDERS = {name: method.order for name, method in METHODS.items() if not method.adaptive}
+"""The order each fixed-step method should show: its :attr:`~tumble.rigid.Method.order`."""
+DEFAULT_MAX_ORDER = 4
+"""Orders studied by default. A higher order (``rkmk8``) reaches round-off (about 1e-15) at
+the default steps; it shows its order with ``step_counts=HIGH_ORDER_STEP_COUNTS``."""
+DEFAULT_METHODS = fixed_step_methods(max_order=DEFAULT_MAX_ORDER)
+"""The methods studied by default: every fixed-step method of order at most 4."""
 HIGH_ORDER_STEP_COUNTS = (20, 25, 32, 40, 50)
 """Steps over [0, 10 s] for ``rkmk8``: h = 0.5 … 0.2, errors 7.7e-10 … 4.8e-13."""
 INERTIA = (2.0, 1.0, 2.0 / 3.0)
@@ -64,7 +59,7 @@ ROUND_OFF_FLOOR = 1e-13
 Double-precision rounding over a run of a few thousand steps leaves ``‖R − R_exact‖_F`` at
 about 1e-15 … 1e-14 whatever h is (``rkmk8`` at the default steps: 5e-15 … 8e-15, a slope of
 0.1); 1e-13 keeps a decade of margin above it."""
-FIXED_STEP_METHODS = tuple(name for name, method in METHODS.items() if not method.adaptive)
+FIXED_STEP_METHODS = fixed_step_methods()
 """The methods that have an observed order in h: every method with a fixed step."""
 
 
@@ -148,9 +143,7 @@ def run(
     >>> round(result.summary["results"]["seed-rk4"]["observed_order"], 1)
     2.0
     """
-    methods = (methods,) if isinstance(methods, str) else tuple(methods)
-    if not methods:
-        raise _checks.fail("methods", methods, "at least one method name")
+    methods = method_names(methods)
     for method in methods:
         _check_fixed_step("methods", methods, method)
     counts = np.asarray(step_counts)

@@ -40,6 +40,7 @@ from tumble.rigid import Force, Gravity, Impulse, RigidBody, Torque, Trajectory,
 from tumble.rigid.initial import check_steps, initial_attitude
 from tumble.rigid.methods import METHODS, get_method
 from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios._common import json_number
 from tumble.scenarios.bodies import Body
 from tumble.scenarios.schema import (
     Matrix3,
@@ -324,16 +325,6 @@ def _conserved(forces: list) -> dict[str, bool]:
     }
 
 
-def _relative_drift(values: np.ndarray) -> float | None:
-    """Largest ``|v − v₀| / |v₀|`` over the run (norms for vectors); None if ``v₀ = 0``."""
-    values = values.reshape(len(values), -1)
-    scale = float(np.linalg.norm(values[0]))
-    if scale == 0.0 or not np.isfinite(scale):
-        return None
-    with np.errstate(all="ignore"):
-        return float(np.max(np.linalg.norm(values - values[0], axis=1)) / scale)
-
-
 def _summary(options: Options, properties, trajectory: Trajectory, forces: list) -> dict:
     moments, _ = properties.principal()
     final = {
@@ -363,9 +354,9 @@ def _summary(options: Options, properties, trajectory: Trajectory, forces: list)
         "message": trajectory.message,
         "n_steps": trajectory.n_steps,
         "final": final,
-        "energy_drift": _relative_drift(trajectory.energy),
-        "momentum_drift": _relative_drift(trajectory.L_world),
-        "max_orthogonality_error": float(np.max(trajectory.orthogonality_error)),
+        "energy_drift": json_number(trajectory.energy_drift),  # None if E₀ = 0
+        "momentum_drift": json_number(trajectory.momentum_drift),  # None if L₀ = 0
+        "max_orthogonality_error": trajectory.orthogonality_drift,
         "conserved": _conserved(forces),
     }
 

@@ -22,10 +22,11 @@ from functools import partial
 
 import numpy as np
 
-from tumble import _checks, exact, mass, meshes
+from tumble import exact, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, simulate
 from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._common import json_number, method_names
 from tumble.viz import rigid
 
 NAME = "torus-spin"
@@ -37,13 +38,6 @@ OMEGA0 = (1.0, 1.0, 1.0)
 """Seed 000's angular velocity (rad/s), here the initial body-frame value."""
 GRID_SPAN = 20.0
 """Seconds of R(t) shown in the component grid (the whole run would be a blur)."""
-
-
-def _methods(methods: Sequence[str] | str) -> tuple[str, ...]:
-    methods = (methods,) if isinstance(methods, str) else tuple(methods)
-    if not methods:
-        raise _checks.fail("methods", methods, "at least one method name")
-    return methods
 
 
 def run(
@@ -91,7 +85,7 @@ def run(
     ...     "orthogonality_error"]
     True
     """
-    methods = _methods(methods)
+    methods = method_names(methods)
     properties = mass.torus(major_radius, minor_radius, density=density)
     body = RigidBody.from_mass_properties(properties)
     runs = {method: simulate(body, t_end, method=method, h=h, omega0=omega0) for method in methods}
@@ -140,24 +134,17 @@ def precession_rate(inertia: np.ndarray, omega0: Sequence[float]) -> float:
     return float((perpendicular - symmetric) * omega0[2] / perpendicular)
 
 
-def _number(value: float | np.floating) -> float | None:
-    """A float for JSON, or None where the run overflowed (JSON has no inf or nan)."""
-    return float(value) if np.isfinite(value) else None
-
-
 def _summary(body, runs, exact_R, h, t_end, omega0) -> dict:
     results = {}
     for method, run in runs.items():
         with np.errstate(all="ignore"):  # euler may end near overflow
-            energy_drift = np.max(np.abs(run.energy / run.energy[0] - 1.0))
             error = np.linalg.norm(run.R[-1] - exact_R[method][-1])
-            orthogonality = run.orthogonality_error
         results[method] = {
             "t_reached": float(run.t[-1]),
-            "orthogonality_error": _number(orthogonality[-1]),
-            "max_orthogonality_error": _number(np.max(orthogonality)),
-            "error_vs_exact": _number(error),
-            "energy_drift": _number(energy_drift),
+            "orthogonality_error": json_number(run.orthogonality_error[-1]),
+            "max_orthogonality_error": json_number(run.orthogonality_drift),
+            "error_vs_exact": json_number(error),
+            "energy_drift": json_number(run.energy_drift),
         }
     return {
         "scenario": NAME,

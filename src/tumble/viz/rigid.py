@@ -150,14 +150,15 @@ def euler_angles(curves: Sequence[Curve], path: str | Path, *, title: str) -> No
 
 
 def _drift_series(run) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Relative energy error, relative |L − L0| and ‖RᵀR − I‖ of one trajectory."""
+    """``|E − E₀|/E₀``, ``‖L − L₀‖/‖L₀‖`` (unscaled if L₀ = 0) and ``‖RᵀR − I‖`` of one run.
+
+    The series behind :class:`~tumble.rigid.Trajectory`'s ``energy_drift``, ``momentum_drift``
+    and ``orthogonality_drift`` (their maxima).
+    """
     with np.errstate(all="ignore"):
-        energy = np.abs(run.energy / run.energy[0] - 1.0)
-        L0 = run.L_world[0]
-        scale = np.linalg.norm(L0) or 1.0
-        momentum = np.linalg.norm(run.L_world - L0, axis=1) / scale
-        orthogonality = run.orthogonality_error
-    return energy, momentum, orthogonality
+        energy = np.abs(run.energy_error) / abs(run.energy[0])
+        momentum = run.momentum_error / (np.linalg.norm(run.L_world[0]) or 1.0)
+    return energy, momentum, run.orthogonality_error
 
 
 def drift(runs: Sequence[tuple[str, Trajectory]], path: str | Path, *, title: str) -> None:
