@@ -5,8 +5,7 @@
 :func:`simulate`           one entry point for every method; returns a :class:`Trajectory`
 :func:`simulate_batch`     many bodies in one compiled, parallel call; a :class:`BatchTrajectory`
 :class:`Gravity` …         loads: :class:`Force`, :class:`Torque`, :class:`Impulse`
-:data:`METHODS`            ``euler``, ``lie-euler``, ``rk4-matrix``, ``rk4-quat``,
-                           ``seed-rk4``, ``rkmk4``, ``rkmk8``, ``rkmk45``
+:data:`METHODS`            every method by name (the table: :mod:`tumble.rigid.methods`)
 =========================  ===================================================================
 """
 
