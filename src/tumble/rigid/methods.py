@@ -6,6 +6,8 @@ name                    family    tableau     what it is
 ``euler``               matrix    Euler       seed 002 eq. 24, ``W + h W Ω̃``: leaves SO(3)
 ``rk4-matrix``          matrix    RK4         classical RK4 on the flattened matrix (seed 000's
                                               ``odeint`` way): order 4, drifts off SO(3)
+``euler-quat``          quat      Euler       seed 001's first listing: Euler on
+                                              ``q̇ = ½ q ⊗ (0, ω)``, then ``q ← q/|q|``
 ``rk4-quat``            quat      RK4         seed 001: RK4 on ``q̇ = ½ q ⊗ (0, ω)``, then
                                               ``q ← q/|q|``
 ``lie-euler``           lie       Euler       seed 002 eq. 25, ``W exp(h Ω̃)``
@@ -83,6 +85,7 @@ METHODS: dict[str, Method] = {
     for method in (
         Method("euler", "matrix", EULER),
         Method("rk4-matrix", "matrix", RK4),
+        Method("euler-quat", "quat", EULER),
         Method("rk4-quat", "quat", RK4),
         Method("lie-euler", "lie", EULER),
         Method("seed-rk4", "lie", RK4, dexpinv=False, order_override=2),

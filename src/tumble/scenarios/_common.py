@@ -45,8 +45,8 @@ def fixed_step_methods(*, max_order: int | None = None) -> tuple[str, ...]:
 
     Examples
     --------
-    >>> fixed_step_methods(max_order=1)
-    ('euler', 'lie-euler')
+    >>> "rkmk4" in fixed_step_methods(), "rkmk8" in fixed_step_methods(max_order=4)
+    (True, False)
     """
     return tuple(
         name
