@@ -250,7 +250,8 @@ def kernel_run(problem: Problem, method: str, h: float) -> np.ndarray:
     n, zero, none = round(T_END / h), np.zeros(3), np.zeros((0, 3))
     z, Rn = LIE.pack(np.eye(3), np.concatenate([zero, zero, problem.omega0 * problem.inertia]))
     data = kernels.Problem(True, tableau.A, tableau.b, problem.body.inertia_inverse,
-                           problem.body.mass, zero, zero, none, none)  # fmt: skip
+                           problem.body.mass, zero, zero, none, none, np.eye(3),
+                           np.ones(3))  # fmt: skip
     record = kernels.Records(np.empty(1), np.empty((1, 3, 3)), np.empty((1, 4)), np.empty((1, 9)))
     kernels.COMPILED["lie"].loop(data, Grid(0.0, T_END, h, n), z, Rn, 0, n, 10**9, 0, record)
     return Rn

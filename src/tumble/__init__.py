@@ -13,7 +13,8 @@ ODE core
 Rigid bodies
 :class:`RigidBody`                  mass and inertia about the centre of mass
 :func:`simulate`                    every rigid-body method through one entry point
-:class:`Gravity`, :class:`Force`    loads (also :class:`Torque`, :class:`Impulse`)
+:class:`Gravity`, :class:`Force`    loads (also :class:`Torque`, :class:`MagneticDipole`,
+                                    :class:`Impulse`)
 :class:`Trajectory`                 what ``simulate`` returns
 :func:`simulate_batch`              many bodies at once (compiled, parallel); a
                                     :class:`BatchTrajectory`
@@ -50,6 +51,7 @@ if TYPE_CHECKING:  # what static type checkers see; at run time __getattr__ impo
         Force,
         Gravity,
         Impulse,
+        MagneticDipole,
         RigidBody,
         Torque,
         Trajectory,
@@ -66,6 +68,7 @@ __all__ = [
     "Force",
     "Gravity",
     "Impulse",
+    "MagneticDipole",
     "METHODS",
     "OdeResult",
     "RigidBody",
@@ -95,6 +98,7 @@ _NAMES = {
             "Force",
             "Gravity",
             "Impulse",
+            "MagneticDipole",
             "RigidBody",
             "Torque",
             "Trajectory",

@@ -9,6 +9,7 @@ from tumble.rigid import (
     Force,
     Gravity,
     Impulse,
+    MagneticDipole,
     RigidBody,
     Torque,
     simulate,
@@ -21,6 +22,7 @@ LOADS = [
     Force((0.1, 0.2, 0.3), point=(0.1, 0.0, 0.05)),
     Force((0.0, -0.5, 0.0)),
     Torque((0.01, 0.0, -0.02)),
+    MagneticDipole((0.2, -0.1, 0.3), (0.0, 0.5, 0.4)),
 ]
 FIELDS = ["t", "x", "v", "R", "L_world", "q", "omega_body", "energy", "orthogonality_error"]
 RNG = np.random.default_rng(7)

@@ -86,13 +86,18 @@ def test_euler_on_the_sphere_drifts_off_so3_by_the_closed_form():
     assert run.energy_drift == 0.0 and run.momentum_drift == 0.0
 
 
-def test_energy_error_under_gravity_is_the_closed_form():
-    # Kinetic energy only: E − E₀ = m (v₀·g t + ½ |g|² t²); RK4 steps the linear v exactly.
+def test_energy_under_gravity_splits_into_the_closed_forms():
+    # T − T₀ = m (v₀·g t + ½ |g|² t²), V = −m g·x = −(T − T₀); RK4 steps the linear v and the
+    # quadratic x exactly, so the total energy T + V stays at T₀ to round-off.
     g, v0, body = np.array([0.0, 0.0, -9.81]), np.array([3.0, 0.0, 4.0]), RigidBody(2.0, np.eye(3))
     run = simulate(body, 1.0, h=0.1, v0=v0, forces=[Gravity(g)])
     expected = 2.0 * (v0 @ g * run.t + 0.5 * (g @ g) * run.t**2)
-    np.testing.assert_allclose(run.energy_error, expected, rtol=1e-13, atol=1e-13)
-    assert run.energy_drift == pytest.approx(np.abs(expected).max() / 25.0, rel=1e-13)
+    kinetic = run.kinetic_energy - run.kinetic_energy[0]
+    np.testing.assert_allclose(kinetic, expected, rtol=1e-13, atol=1e-13)
+    np.testing.assert_allclose(run.potential_energy, -2.0 * run.x @ g, rtol=1e-15)
+    np.testing.assert_allclose(run.potential_energy, -expected, rtol=1e-13, atol=1e-13)
+    assert np.abs(run.energy_error).max() < 1e-13 * 25.0
+    assert run.energy_drift < 1e-13
 
 
 def test_lie_euler_on_the_sphere_keeps_every_invariant():

@@ -429,5 +429,5 @@ def test_an_empty_list_is_refused_where_the_default_is_not_empty(name, option):
 
 
 def test_convergence_lists_only_fixed_step_methods():
-    with pytest.raises(ValueError, match=r"must be one of euler, .*, rkmk8$"):
+    with pytest.raises(ValueError, match=r"must be one of euler, .*, rkmk8, split-axes, .*, dmv$"):
         check_options("convergence", {"methods": "rkmk45"})

@@ -180,7 +180,9 @@ def test_other_loads_are_accepted_and_not_drawn(run, mesh):
 
 def test_fewer_samples_than_frames_gives_one_frame_per_sample(run, mesh):
     short = dataclasses.replace(run, t=run.t[:4], x=run.x[:4], v=run.v[:4], R=run.R[:4])
-    short = dataclasses.replace(short, L_world=run.L_world[:4])
+    short = dataclasses.replace(
+        short, L_world=run.L_world[:4], potential_energy=run.potential_energy[:4]
+    )
     assert len(viewer_figure(short, mesh, title="T", frames=20).frames) == 4
 
 

@@ -24,6 +24,9 @@ A stepper is an object with (see :class:`Stepper`, which gives the defaults):
     that events are located on). Called only after ``accept``.
 ``finite(state) -> bool``, ``scale(state) -> ndarray``
     Whether every number of a state is finite; the magnitudes the error is relative to.
+``failure(t_old, t_new) -> str``
+    Why the step from ``t_old`` to ``t_new`` gave a state that is not finite (by default
+    :func:`non_finite_message`; an implicit stepper names its unconverged solve).
 ``record(state) -> tuple of ndarray``
     One sample: each array with a time axis of length 1 at :attr:`~Stepper.time_axis`.
 ``march_block(state, grid, k0, k1, every, step0) -> Block`` (optional, ``blocks = True``)
@@ -201,6 +204,10 @@ class Stepper:
     def scale(self, state: Any) -> np.ndarray:
         return np.abs(state)
 
+    def failure(self, t_old: float, t_new: float) -> str:
+        """Why the step from ``t_old`` to ``t_new`` gave a state that is not finite."""
+        return non_finite_message(t_old, t_new)
+
     def record(self, state: Any) -> tuple:
         return (np.asarray(state)[None],)
 
@@ -357,7 +364,7 @@ def _fixed(run: _Run, t1: float, h: float) -> bool:
         t_old, old, t_new = run.t, run.state, grid.time(k)
         new, _ = stepper.step(t_old, old, t_new - t_old)
         if not stepper.finite(new):
-            run.fail(non_finite_message(t_old, t_new))
+            run.fail(stepper.failure(t_old, t_new))
             return False
         if run.accept(t_old, old, t_new, new):
             return False
@@ -394,7 +401,7 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
                 return False, h
             continue
         if not stepper.finite(new):
-            run.fail(non_finite_message(t_old, t_new))
+            run.fail(stepper.failure(t_old, t_new))
             return False, h
         if run.accept(t_old, old, t_new, new):
             return False, h
@@ -415,7 +422,7 @@ def _blocks(run: _Run, t1: float, h: float) -> bool:
         run.n_steps += done - k0
         run.t, run.state = grid.time(done), block.state
         if block.failed >= 0:
-            run.fail(non_finite_message(run.t, grid.time(block.failed)))
+            run.fail(run.stepper.failure(run.t, grid.time(block.failed)))
             return False
         if run.progress is not None:
             run.progress(run.t)

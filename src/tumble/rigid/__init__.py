@@ -4,14 +4,15 @@
 :class:`RigidBody`         mass and inertia about the centre of mass (body axes)
 :func:`simulate`           one entry point for every method; returns a :class:`Trajectory`
 :func:`simulate_batch`     many bodies in one compiled, parallel call; a :class:`BatchTrajectory`
-:class:`Gravity` …         loads: :class:`Force`, :class:`Torque`, :class:`Impulse`
+:class:`Gravity` …         loads: :class:`Force`, :class:`Torque`, :class:`MagneticDipole`,
+                           :class:`Impulse`
 :data:`METHODS`            every method by name (the table: :mod:`tumble.rigid.methods`)
 =========================  ===================================================================
 """
 
 from tumble.rigid.batch import BatchTrajectory, simulate_batch
 from tumble.rigid.body import RigidBody
-from tumble.rigid.forces import Force, Gravity, Impulse, State, Torque
+from tumble.rigid.forces import Force, Gravity, Impulse, MagneticDipole, State, Torque
 from tumble.rigid.methods import METHODS, Method
 from tumble.rigid.simulation import simulate
 from tumble.rigid.trajectory import Trajectory
@@ -22,6 +23,7 @@ __all__ = [
     "Force",
     "Gravity",
     "Impulse",
+    "MagneticDipole",
     "Method",
     "RigidBody",
     "State",

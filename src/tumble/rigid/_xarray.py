@@ -21,7 +21,9 @@ def trajectory_dataset(trajectory):
         "q": (("time", "component"), trajectory.q, "1", "unit quaternion [w, x, y, z]"),
         "omega_body": (vec, trajectory.omega_body, "rad/s", "angular velocity, body frame"),
         "L_world": (vec, trajectory.L_world, "kg m2/s", "angular momentum, world frame"),
-        "energy": (("time",), trajectory.energy, "J", "kinetic energy"),
+        "energy": (("time",), trajectory.energy, "J", "total energy T + V"),
+        "kinetic_energy": (("time",), trajectory.kinetic_energy, "J", "kinetic energy"),
+        "potential_energy": (("time",), trajectory.potential_energy, "J", "potential energy"),
         "orthogonality_error": (("time",), trajectory.orthogonality_error, "1", "|RᵀR − I|_F"),
     }
     data_vars = {
@@ -71,4 +73,9 @@ def trajectory_from_dataset(dataset):
         status=int(attrs.get("status", 0)),
         message=str(attrs.get("message", "")),
         q_raw=values["q"],
+        potential_energy=(
+            np.asarray(dataset["potential_energy"].values)
+            if "potential_energy" in dataset
+            else None
+        ),
     )

@@ -20,11 +20,20 @@ from numpy.typing import ArrayLike
 from tumble import _checks, so3
 from tumble.ode.control import fixed_step_count
 from tumble.ode.driver import Block, Grid, Status, Stepper, march, non_finite_message
-from tumble.rigid import initial
+from tumble.rigid import geometric, initial
 from tumble.rigid.body import RigidBody
 from tumble.rigid.charts import CHARTS
-from tumble.rigid.forces import Impulse, Load, State, compiled_loads, split_loads
+from tumble.rigid.forces import (
+    Impulse,
+    Load,
+    State,
+    compiled_loads,
+    potential_energy,
+    split_loads,
+)
 from tumble.rigid.methods import METHODS, Method, get_method
+from tumble.rigid.simulation import problem
+from tumble.rigid.steppers import unconverged_message
 from tumble.rigid.trajectory import Trajectory
 
 FIXED_METHODS = [name for name, method in METHODS.items() if not method.adaptive]
@@ -64,6 +73,8 @@ class BatchTrajectory:
         How many samples of each body are valid (all ``n`` unless it stopped early).
     q_raw : ndarray, shape (N, n, 4), optional
         The quaternions the ``quat`` method carried.
+    potential_energy : ndarray, shape (N, n), optional
+        ``V`` of the loads that have a potential, J (zeros if None).
     t_last : ndarray, shape (N,), optional
         Time (s) of each body's last valid sample, row ``n_recorded[k] - 1``: ``t_end``, or
         for a stopped body the time of its last finite state, which lies between two times
@@ -84,6 +95,11 @@ class BatchTrajectory:
     n_recorded: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     q_raw: np.ndarray | None = None
     t_last: np.ndarray | None = None
+    potential_energy: np.ndarray = None  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.potential_energy is None:
+            self.potential_energy = np.zeros(self.x.shape[:2])
 
     def __len__(self) -> int:
         return len(self.bodies)
@@ -108,6 +124,7 @@ class BatchTrajectory:
             message=self.messages[k],
             n_steps=int(self.n_steps[k]),
             q_raw=None if self.q_raw is None else self.q_raw[k, :n],
+            potential_energy=self.potential_energy[k, :n],
         )
 
     @property
@@ -139,13 +156,20 @@ class BatchTrajectory:
             return body_L @ self._inverse_inertia.swapaxes(-1, -2)
 
     @cached_property
-    def energy(self) -> np.ndarray:
+    def kinetic_energy(self) -> np.ndarray:
         """Kinetic energy ``½ m |v|² + ½ ω·(Rᵀ L)``, shape (N, n), J."""
         mass = _per_body(self.bodies, lambda body: body.mass)[:, None]
         with np.errstate(over="ignore", invalid="ignore"):  # a diverged body: inf, no warning
             body_L = np.einsum("knji,knj->kni", self.R, self.L_world)
             rotational = 0.5 * np.einsum("kni,kni->kn", self.omega_body, body_L)
             return 0.5 * mass * np.einsum("kni,kni->kn", self.v, self.v) + rotational
+
+    @cached_property
+    def energy(self) -> np.ndarray:
+        """Total energy ``T + V``, shape (N, n), J (as :attr:`Trajectory.energy
+        <tumble.rigid.trajectory.Trajectory.energy>`)."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            return self.kinetic_energy + self.potential_energy
 
     @cached_property
     def orthogonality_error(self) -> np.ndarray:
@@ -304,8 +328,7 @@ def _kernel_loads(forces, bodies):
             remedy="impulses and callable forces need tumble.simulate (one body per call)",
         )  # fmt: skip
     F = _per_body(bodies, lambda body: compiled_loads(loads, body.mass)[0]).copy()
-    _, tau, points, point_forces = compiled_loads(loads, bodies[0].mass)
-    return F, tau, points, point_forces
+    return (F, *compiled_loads(loads, bodies[0].mass)[1:])
 
 
 def _record_times(grid: Grid, every: int) -> np.ndarray:
@@ -424,38 +447,59 @@ def simulate_batch(
                            rows["x0"], rows["v0"], n_bodies)  # fmt: skip
     loads = _kernel_loads(forces, bodies)
     settings = {"h": h, "rtol": None, "atol": None, "record_every": every, "compiled": True}
-    return _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings)
+    batch = _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings)
+    with np.errstate(over="ignore", invalid="ignore"):
+        batch.potential_energy = np.array([
+            potential_energy(split_loads(forces)[0], batch.x[k], batch.R[k], body.mass)
+            for k, body in enumerate(batch.bodies)
+        ]).reshape(batch.x.shape[:2])  # fmt: skip
+    return batch
 
 
 class BatchStepper(Stepper):
-    """Every body of a batch in the chart's compiled batch loop, as one block of the driver.
+    """Every body of a batch in the method's compiled batch loop, as one block of the driver.
 
     The state is ``(attitude, Y)`` with a leading body axis; samples are stacked along axis 1
     (time). A body whose state stops being finite stops alone: the block goes on for the
     others, and :attr:`counts` and :attr:`failed` say, per body, how many samples it
-    recorded and at which step it stopped (-1: none).
+    recorded and at which step it stopped (-1: none); :attr:`causes` why
+    (:data:`~tumble.rigid.kernels.NON_FINITE` or ``UNCONVERGED``).
+    ``split`` methods carry ``R_p = R P`` with each body's principal axes ``P``.
     """
 
     blocks = True
     time_axis = 1
 
     def __init__(self, method: Method, problem):
-        from tumble.rigid.kernels import COMPILED
+        from tumble.rigid.kernels import COMPILED, COMPILED_FLOWS
 
-        self.chart, self.problem = CHARTS[method.family], problem
-        self.batch = COMPILED[self.chart.name].batch
-        self._quat = self.chart.name == "quat"
-        self.counts = self.failed = np.zeros(0, dtype=np.int64)
+        self.method, self.problem = method, problem
+        self.split = method.family == "split"
+        if self.split:
+            assert method.flow is not None
+            self.batch = COMPILED_FLOWS[method.flow].batch
+        else:
+            self.chart = CHARTS[method.family]
+            self.batch = COMPILED[self.chart.name].batch
+        self._quat = method.family == "quat"
+        self.counts = self.failed = self.causes = np.zeros(0, dtype=np.int64)
 
     def start(self, state: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """The stepped state for ``(R, Y)`` with a leading body axis."""
         R, Y = state
+        if self.split:
+            return R @ self.problem.axes, Y
         return self.chart.attitude(R), Y
+
+    def _matrix(self, attitude: np.ndarray) -> np.ndarray:
+        if self.split:
+            return attitude @ np.swapaxes(self.problem.axes, -1, -2)
+        return self.chart.matrix(attitude)
 
     def record(self, state) -> tuple:
         attitude, Y = state
         q = attitude[:, None] if self._quat else np.empty((len(Y), 1, 0))
-        return self.chart.matrix(attitude)[:, None], Y[:, None], q
+        return self._matrix(attitude)[:, None], Y[:, None], q
 
     def march_block(self, state, grid: Grid, k0: int, k1: int, every: int, step0: int) -> Block:
         from tumble.rigid.kernels import Records
@@ -464,15 +508,19 @@ class BatchStepper(Stepper):
             raise NotImplementedError("a batch marches its whole grid in one block")
         n_bodies, size = len(state[1]), grid.n // every  # samples at steps every, 2 every, …
         records = Records(*(np.empty((n_bodies, size, *shape)) for shape in RECORD_SHAPES))
-        self.counts = np.zeros(n_bodies, dtype=np.int64)
-        self.failed = np.zeros(n_bodies, dtype=np.int64)
-        Z, RN = self.chart.pack(*state)
-        self.batch(self.problem, grid, Z, RN, every, records, self.counts, self.failed)
+        self.counts, self.failed, self.causes = (np.zeros(n_bodies, dtype=np.int64)
+                                                 for _ in range(3))  # fmt: skip
+        if self.split:
+            Z, RN = np.array(state[1], dtype=float), np.array(state[0], dtype=float)
+        else:
+            Z, RN = self.chart.pack(*state)
+        self.batch(self.problem, grid, Z, RN, every, records, self.counts, self.failed,
+                   self.causes)  # fmt: skip
         q = records.q if self._quat else np.empty((n_bodies, size, 0))
         return Block(
             t=_record_times(grid, every),
             records=(records.R, records.Y, q),
-            state=self.chart.read(Z, RN),
+            state=(RN, Z) if self.split else self.chart.read(Z, RN),
         )
 
 
@@ -482,15 +530,12 @@ RECORD_SHAPES = ((), (3, 3), (4,), (9,))
 
 def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTrajectory:
     """Run the kernel for every body; lay the samples out as (body, time, …) arrays."""
-    from tumble.rigid.kernels import Problem
-
-    F, tau, points, point_forces = loads
     mass = _per_body(bodies, lambda body: body.mass)
     inv_I = _per_body(bodies, lambda body: body.inertia_inverse)
-    tableau = spec.tableau
-    problem = Problem(spec.dexpinv, tableau.A, tableau.b, inv_I, mass, F, tau, points,
-                      point_forces)  # fmt: skip
-    stepper = BatchStepper(spec, problem)
+    frames = [geometric.principal_frame(body.inertia) for body in bodies]
+    moments = np.array([frame[0] for frame in frames])
+    axes = np.array([frame[1] for frame in frames])
+    stepper = BatchStepper(spec, problem(spec, inv_I, mass, loads, axes, moments))
     out = march(stepper, (t0, t_end), stepper.start((R, Y)), h=h, record_every=every)
     names = ("R", "Y", "q") if spec.family == "quat" else ("R", "Y")
     samples = dict(zip(names, out.records, strict=False))
@@ -511,7 +556,7 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
         method=spec.name,
         settings=settings,
         status=np.where(failed < 0, Status.SUCCESS, Status.FAILED),
-        messages=_messages(failed, grid),
+        messages=_messages(spec, failed, stepper.causes, grid),
         n_steps=np.where(failed < 0, grid.n, failed - 1),
         n_recorded=n_recorded,
         q_raw=samples.get("q"),
@@ -542,10 +587,17 @@ def _end_stopped_bodies(samples, last, times, counts, failed, grid):
     return n_recorded, t_last
 
 
-def _messages(failed: np.ndarray, grid: Grid) -> list[str]:
-    """Per body, ``simulate``'s message: the end reached, or the step that was not finite."""
+def _messages(spec: Method, failed: np.ndarray, causes: np.ndarray, grid: Grid) -> list[str]:
+    """Per body, ``simulate``'s message: the end reached, the step that was not finite, or
+    the step whose implicit flow did not converge."""
+    from tumble.rigid.kernels import UNCONVERGED
+
     messages = [Status.SUCCESS.message] * len(failed)
     for k in np.flatnonzero(failed >= 0):
         step = int(failed[k])
-        messages[k] = non_finite_message(grid.time(step - 1), grid.time(step))
+        t_old, t_new = grid.time(step - 1), grid.time(step)
+        if causes[k] == UNCONVERGED:
+            messages[k] = unconverged_message(spec, t_old, t_new)
+        else:
+            messages[k] = non_finite_message(t_old, t_new)
     return messages

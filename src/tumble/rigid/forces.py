@@ -1,11 +1,14 @@
 """Forces and torques on a rigid body, in the world frame.
 
-Continuous loads (:class:`Gravity`, :class:`Force`, :class:`Torque`) give a force ``F`` on the
-centre of mass and a torque ``τ`` about it at every instant; :class:`Impulse` is a kick at one
-instant. A load that is a constant (not a callable) can run in the compiled kernels; a callable
-runs in Python.
+Continuous loads (:class:`Gravity`, :class:`Force`, :class:`Torque`, :class:`MagneticDipole`)
+give a force ``F`` on the centre of mass and a torque ``τ`` about it at every instant;
+:class:`Impulse` is a kick at one instant. A load that is a constant (not a callable) can run
+in the compiled kernels; a callable runs in Python.
 
 Each load's ``__call__(t, state, mass)`` returns ``(F, τ)``; ``state`` is a :class:`State`.
+A load that derives from a potential also has ``potential(x, R, mass) -> V`` (vectorised over
+samples: ``x`` (n, 3), ``R`` (n, 3, 3)), with ``F = −∂V/∂x`` and ``τ`` the matching torque;
+a :class:`~tumble.Trajectory` reports ``potential_energy`` and the total ``energy`` from it.
 """
 
 from __future__ import annotations
@@ -82,9 +85,14 @@ class Gravity:
         object.__setattr__(self, "g", _vector(self.g, "g", "m/s²"))
 
     compiled = True
+    conservative = True
 
     def __call__(self, t: float, state: State, mass: float) -> tuple[np.ndarray, np.ndarray]:
         return mass * self.g, _ZERO
+
+    def potential(self, x: np.ndarray, R: np.ndarray, mass: float) -> np.ndarray:
+        """``V = −m g·x`` (J)."""
+        return -mass * (x @ self.g)
 
 
 @dataclass(frozen=True)
@@ -119,6 +127,16 @@ class Force:
             return F, _ZERO
         return F, np.cross(state.R @ self.point, F)
 
+    @property
+    def conservative(self) -> bool:
+        """A constant force has the potential ``V = −F·(x + R r)``; a callable has none."""
+        return not callable(self.force)
+
+    def potential(self, x: np.ndarray, R: np.ndarray, mass: float) -> np.ndarray:
+        """``V = −F·(x + R r)`` (J), ``r`` the point (0 at the centre of mass)."""
+        where = x if self.point is None else x + R @ self.point
+        return -(where @ self.force)
+
 
 @dataclass(frozen=True)
 class Torque:
@@ -133,8 +151,53 @@ class Torque:
     def compiled(self) -> bool:
         return not callable(self.torque)
 
+    conservative = False
+    """A torque has no potential on SO(3) in general (a constant one neither)."""
+
     def __call__(self, t: float, state: State, mass: float) -> tuple[np.ndarray, np.ndarray]:
         return _ZERO, _evaluate(self.torque, t, state, "torque")
+
+
+@dataclass(frozen=True)
+class MagneticDipole:
+    """A body-fixed magnetic dipole in a uniform field: a compass needle, a magnetorquer.
+
+    The torque is ``τ = (R μ) × B`` and the potential ``V = −(R μ)·B``; a uniform field
+    exerts no force. The load derives from a potential, so the splitting methods
+    (``split-axes``, ``split-axes4``, …) keep the total energy ``T + V`` bounded.
+
+    Parameters
+    ----------
+    moment : array_like, shape (3,)
+        The magnetic moment ``μ`` in body axes (A m²).
+    field : array_like, shape (3,)
+        The flux density ``B`` in world axes (T).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> needle = MagneticDipole(moment=(1.0, 0.0, 0.0), field=(0.0, 2.0, 0.0))
+    >>> R = np.eye(3)
+    >>> needle(0.0, State(np.zeros(3), R, np.zeros(3), np.zeros(3)), 1.0)[1]
+    array([0., 0., 2.])
+    """
+
+    moment: Vector
+    field: Vector
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "moment", _vector(self.moment, "moment", "A m²"))
+        object.__setattr__(self, "field", _vector(self.field, "field", "T"))
+
+    compiled = True
+    conservative = True
+
+    def __call__(self, t: float, state: State, mass: float) -> tuple[np.ndarray, np.ndarray]:
+        return _ZERO, np.cross(state.R @ self.moment, self.field)
+
+    def potential(self, x: np.ndarray, R: np.ndarray, mass: float) -> np.ndarray:
+        """``V = −(R μ)·B`` (J)."""
+        return -((R @ self.moment) @ self.field)
 
 
 @dataclass(frozen=True)
@@ -169,7 +232,7 @@ class Impulse:
         return self.impulse.copy(), np.cross(self.point - x, self.impulse)
 
 
-Load = Gravity | Force | Torque
+Load = Gravity | Force | Torque | MagneticDipole
 
 
 def split_loads(forces) -> tuple[list[Load], list[Impulse]]:
@@ -178,13 +241,14 @@ def split_loads(forces) -> tuple[list[Load], list[Impulse]]:
     for index, item in enumerate(forces):
         if isinstance(item, Impulse):
             impulses.append(item)
-        elif isinstance(item, Gravity | Force | Torque):
+        elif isinstance(item, Gravity | Force | Torque | MagneticDipole):
             loads.append(item)
         else:
             raise _checks.fail(
                 f"forces[{index}]",
                 item,
-                "a load: tumble.Gravity, tumble.Force, tumble.Torque or tumble.Impulse",
+                "a load: tumble.Gravity, tumble.Force, tumble.Torque, tumble.MagneticDipole "
+                "or tumble.Impulse",
             )
     return loads, impulses
 
@@ -199,8 +263,23 @@ def total_load(loads, t: float, state: State, mass: float) -> tuple[np.ndarray, 
     return F, tau
 
 
+def potential_energy(loads, x: np.ndarray, R: np.ndarray, mass: float) -> np.ndarray:
+    """``V`` of the loads that have a potential, summed, at samples ``x`` (n, 3), ``R``
+    (n, 3, 3); shape (n,), J. Loads without one (:class:`Torque`, callables) add nothing."""
+    V = np.zeros(len(x))
+    for load in loads:
+        if load.conservative:
+            V = V + load.potential(x, R, mass)
+    return V
+
+
 def compiled_loads(loads, mass: float):
     """Constant loads as arrays for the kernels, or None if any load is a callable.
+
+    A magnetic dipole ``μ`` in the field ``B`` has the torque ``(R μ) × B`` of a force ``B``
+    at the body point ``μ``: it is listed among the points, with ``B`` taken off the force
+    on the centre of mass (a uniform field exerts none). The kernels' load loop stays one
+    loop.
 
     Returns
     -------
@@ -216,6 +295,10 @@ def compiled_loads(loads, mass: float):
             F += mass * load.g
         elif isinstance(load, Torque):
             tau += load.torque
+        elif isinstance(load, MagneticDipole):
+            points.append(load.moment)
+            point_forces.append(load.field)
+            F -= load.field
         elif load.point is None:
             F += load.force
         else:

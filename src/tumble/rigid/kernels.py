@@ -30,6 +30,10 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit, prange
 
+NON_FINITE, UNCONVERGED = 0, 1
+"""Why a loop stopped at a step: its state was not finite, or an implicit flow's Newton
+iteration did not converge (``split`` loops)."""
+
 SERIES_ANGLE = 0.25
 """Below this angle (rad) the exp and dexp⁻¹ coefficients use their Taylor series; the first
 term left out is below 1e-17 relative (θ¹²/13! for sin θ/θ, 8e-19 for dexp⁻¹)."""
@@ -234,10 +238,13 @@ class Problem(NamedTuple):
     """What the compiled loops need of a run besides its state: method and loads.
 
     ``correct``: stages corrected by dexp⁻¹ (False only for ``seed-rk4``); ``A``, ``b``: the
-    tableau; ``inv_I`` (3, 3), ``m``: the body; ``F`` (3,), ``tau`` (3,): constant force on
-    the centre of mass and torque (world); ``points`` (k, 3), ``point_forces`` (k, 3): body
-    points and the constant world forces there. For :func:`run_batch` ``inv_I``, ``m`` and
-    ``F`` carry a leading body axis.
+    tableau (for a ``split`` method, ``b`` holds the composition weights); ``inv_I`` (3, 3),
+    ``m``: the body; ``F`` (3,), ``tau`` (3,): constant force on the centre of mass and
+    torque (world); ``points`` (k, 3), ``point_forces`` (k, 3): body points and the constant
+    world forces there (magnetic dipoles among them, see
+    :func:`~tumble.rigid.forces.compiled_loads`); ``axes`` (3, 3), ``moments`` (3,): the
+    principal axes and moments (the ``split`` loops). For the batch loops ``inv_I``, ``m``,
+    ``F``, ``axes`` and ``moments`` carry a leading body axis.
     """
 
     correct: bool
@@ -249,6 +256,8 @@ class Problem(NamedTuple):
     tau: np.ndarray
     points: np.ndarray
     point_forces: np.ndarray
+    axes: np.ndarray
+    moments: np.ndarray
 
 
 class Records(NamedTuple):
@@ -272,9 +281,10 @@ def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
 
     then the chart's map back. ``z`` (and ``Rn``) hold the state and are updated in place.
     Step ``k`` is recorded when ``step0 + k`` is a multiple of ``every``. Returns
-    ``(recorded, failed)``: ``failed`` is the step whose result was not finite (the state is
-    left at the step before), or -1. ``FIELD``, ``ADVANCE`` and ``RECORD`` are the chart's
-    compiled functions, bound by :func:`_for_chart`.
+    ``(recorded, failed, cause)``: ``failed`` is the step whose result was not finite (the
+    state is left at the step before), or -1; ``cause`` is :data:`NON_FINITE` then.
+    ``FIELD``, ``ADVANCE`` and ``RECORD`` are the chart's compiled functions, bound by
+    :func:`_for_chart`.
     """
     A, b = problem.A, problem.b
     t_a, t_b, h, n = grid
@@ -299,7 +309,7 @@ def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
             zs[q] = z[q] + hk * acc
             finite = finite and math.isfinite(zs[q])
         if not finite:
-            return count, k
+            return count, k, NON_FINITE
         ADVANCE(z, zs, Rn)  # noqa: F821
         until_record -= 1
         if until_record == 0:
@@ -307,22 +317,24 @@ def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
             RECORD(z, Rn, records.R[count], records.q[count], records.Y[count])  # noqa: F821
             count += 1
             until_record = every
-    return count, -1
+    return count, -1, NON_FINITE
 
 
-def _batch(problem, grid, Z, RN, every, records, counts, failed):
+def _batch(problem, grid, Z, RN, every, records, counts, failed, causes):
     """:data:`LOOP` over all the steps of ``grid`` for every body ``k`` in parallel.
 
     Body ``k``'s state is ``Z[k]`` (and ``RN[k]``), its data ``problem.inv_I[k]``,
-    ``problem.m[k]`` and ``problem.F[k]``; its samples go to ``records.t[k]``, … ;
-    ``counts[k]`` samples and the failed step ``failed[k]`` (-1 if none) come back.
+    ``problem.m[k]``, ``problem.F[k]``, ``problem.axes[k]`` and ``problem.moments[k]``; its
+    samples go to ``records.t[k]``, … ; ``counts[k]`` samples, the failed step ``failed[k]``
+    (-1 if none) and its cause ``causes[k]`` come back.
     """
     for k in prange(Z.shape[0]):
         p = problem
         body = Problem(p.correct, p.A, p.b, p.inv_I[k], p.m[k], p.F[k], p.tau, p.points,
-                       p.point_forces)  # fmt: skip
+                       p.point_forces, p.axes[k], p.moments[k])  # fmt: skip
         body_records = Records(records.t[k], records.R[k], records.q[k], records.Y[k])
-        counts[k], failed[k] = LOOP(body, grid, Z[k], RN[k], 0, grid.n, every, 0, body_records)  # noqa: F821
+        counts[k], failed[k], causes[k] = LOOP(body, grid, Z[k], RN[k], 0, grid.n, every, 0,  # noqa: F821
+                                               body_records)  # fmt: skip
 
 
 def _bind(template, name: str, **functions):
@@ -341,7 +353,7 @@ def _bind(template, name: str, **functions):
 class CompiledChart:
     """A chart's compiled loop for one body (:func:`_loop`) and for a batch (:func:`_batch`)."""
 
-    loop: Callable[..., tuple[int, int]]
+    loop: Callable[..., tuple[int, int, int]]
     batch: Callable[..., None]
 
 
@@ -357,3 +369,237 @@ COMPILED: dict[str, CompiledChart] = {
     "lie": _for_chart("lie", _lie_field, _lie_advance, _lie_record),
 }
 """Each chart of :data:`tumble.rigid.charts.CHARTS`, compiled."""
+
+# ---------------------------------------------------------------------------------------
+# The ``split`` family (:mod:`tumble.rigid.geometric`): kicks, a free-body flow, compiled.
+# The attitude is ``R_p = R P`` (principal frame); a flow turns it in place and returns
+# False when its Newton iteration did not converge.
+
+NEWTON_MAX = 30
+"""As :data:`tumble.rigid.geometric.NEWTON_MAX` (a test checks they agree)."""
+NEWTON_TOL = 4.0 * 2.220446049250313e-16
+"""As :data:`tumble.rigid.geometric.NEWTON_TOL`."""
+
+
+@njit(**_JIT)
+def _solve3(j00, j01, j02, j10, j11, j12, j20, j21, j22, r0, r1, r2):
+    """``J⁻¹ r`` for a 3×3 ``J`` by Cramer's rule (the cofactors, once)."""
+    c00, c01, c02 = j11 * j22 - j12 * j21, j12 * j20 - j10 * j22, j10 * j21 - j11 * j20
+    det = j00 * c00 + j01 * c01 + j02 * c02
+    x0 = (c00 * r0 + (j02 * j21 - j01 * j22) * r1 + (j01 * j12 - j02 * j11) * r2) / det
+    x1 = (c01 * r0 + (j00 * j22 - j02 * j20) * r1 + (j02 * j10 - j00 * j12) * r2) / det
+    x2 = (c02 * r0 + (j01 * j20 - j00 * j21) * r1 + (j00 * j11 - j01 * j10) * r2) / det
+    return x0, x1, x2
+
+
+@njit(**_JIT)
+def _times_matrix(Rp, c00, c01, c02, c10, c11, c12, c20, c21, c22):
+    """``R_p ← R_p C`` in place, row by row."""
+    for r in range(3):
+        a, b, c = Rp[r, 0], Rp[r, 1], Rp[r, 2]
+        Rp[r, 0] = a * c00 + b * c10 + c * c20
+        Rp[r, 1] = a * c01 + b * c11 + c * c21
+        Rp[r, 2] = a * c02 + b * c12 + c * c22
+
+
+@njit(**_JIT)
+def _turn(Rp, m0, m1, m2, axis, angle):
+    """``R_p ← R_p exp(angle ê_axis)`` in place; returns ``exp(−angle ê_axis) m``."""
+    c, s = math.cos(angle), math.sin(angle)
+    j, k = (axis + 1) % 3, (axis + 2) % 3
+    for r in range(3):
+        a, b = Rp[r, j], Rp[r, k]
+        Rp[r, j] = c * a + s * b
+        Rp[r, k] = c * b - s * a
+    if axis == 0:
+        return m0, c * m1 + s * m2, c * m2 - s * m1
+    if axis == 1:
+        return c * m0 - s * m2, m1, c * m2 + s * m0
+    return c * m0 + s * m1, c * m1 - s * m0, m2
+
+
+@njit(**_INLINE)
+def _axes_flow(Rp, L0, L1, L2, moments, h):
+    """Strang's splitting by axes, ``1, 2, 3, 2, 1`` (each rotation exact)."""
+    m0, m1, m2 = _apply_transpose(Rp, L0, L1, L2)
+    m0, m1, m2 = _turn(Rp, m0, m1, m2, 0, 0.5 * h * m0 / moments[0])
+    m0, m1, m2 = _turn(Rp, m0, m1, m2, 1, 0.5 * h * m1 / moments[1])
+    m0, m1, m2 = _turn(Rp, m0, m1, m2, 2, h * m2 / moments[2])
+    m0, m1, m2 = _turn(Rp, m0, m1, m2, 1, 0.5 * h * m1 / moments[1])
+    _turn(Rp, m0, m1, m2, 0, 0.5 * h * m0 / moments[0])
+    return True
+
+
+@njit(**_INLINE)
+def _midpoint_flow(Rp, L0, L1, L2, moments, h):
+    """Implicit midpoint on ``ṁ = m × I⁻¹m`` by Newton, then ``R_p ← R_p cay(h I⁻¹m̄)``."""
+    m0, m1, m2 = _apply_transpose(Rp, L0, L1, L2)
+    i0, i1, i2 = 1.0 / moments[0], 1.0 / moments[1], 1.0 / moments[2]
+    w0, w1, w2 = m0, m1, m2
+    g = 0.5 * h
+    converged = False
+    for _ in range(NEWTON_MAX):
+        y0, y1, y2 = w0 * i0, w1 * i1, w2 * i2
+        c0, c1, c2 = _cross(w0, w1, w2, y0, y1, y2)
+        # J = 1 − (h/2)(ŵ diag(i) − ŷ), ŷ the hat of y = I⁻¹w
+        d0, d1, d2 = _solve3(
+            1.0, -g * (-w2 * i1 + y2), -g * (w1 * i2 - y1),
+            -g * (w2 * i0 - y2), 1.0, -g * (-w0 * i2 + y0),
+            -g * (-w1 * i0 + y1), -g * (w0 * i1 - y0), 1.0,
+            w0 - m0 - g * c0, w1 - m1 - g * c1, w2 - m2 - g * c2,
+        )  # fmt: skip
+        w0, w1, w2 = w0 - d0, w1 - d1, w2 - d2
+        size = w0 * w0 + w1 * w1 + w2 * w2
+        if not math.isfinite(size):
+            return False
+        if d0 * d0 + d1 * d1 + d2 * d2 <= NEWTON_TOL * NEWTON_TOL * size:
+            converged = True
+            break
+    v0, v1, v2 = h * w0 * i0, h * w1 * i1, h * w2 * i2
+    f = 4.0 / (4.0 + v0 * v0 + v1 * v1 + v2 * v2)  # cay(v) = 1 + f (v̂ + v̂²/2)
+    _times_matrix(
+        Rp,
+        1.0 - 0.5 * f * (v1 * v1 + v2 * v2), f * (0.5 * v0 * v1 - v2), f * (0.5 * v0 * v2 + v1),
+        f * (0.5 * v0 * v1 + v2), 1.0 - 0.5 * f * (v0 * v0 + v2 * v2), f * (0.5 * v1 * v2 - v0),
+        f * (0.5 * v0 * v2 - v1), f * (0.5 * v1 * v2 + v0), 1.0 - 0.5 * f * (v0 * v0 + v1 * v1),
+    )  # fmt: skip
+    return converged
+
+
+@njit(**_INLINE)
+def _dmv_flow(Rp, L0, L1, L2, moments, h):
+    """Moser–Veselov: Newton on ``h m = 2 e₀ I e + 2 (D e) × e`` for Ω's quaternion."""
+    m0, m1, m2 = _apply_transpose(Rp, L0, L1, L2)
+    I0, I1, I2 = moments[0], moments[1], moments[2]
+    half = 0.5 * (I0 + I1 + I2)
+    D0, D1, D2 = half - I0, half - I1, half - I2
+    e1, e2, e3 = 0.5 * h * m0 / I0, 0.5 * h * m1 / I1, 0.5 * h * m2 / I2
+    converged = False
+    for _ in range(NEWTON_MAX):
+        e0 = math.sqrt(1.0 - (e1 * e1 + e2 * e2 + e3 * e3))
+        c0, c1, c2 = _cross(D0 * e1, D1 * e2, D2 * e3, e1, e2, e3)
+        a0, a1, a2 = I0 * e1, I1 * e2, I2 * e3
+        # J = 2e₀ diag(I) − 2 (I e) eᵀ/e₀ + 2 ((D e)^ − ê diag(D))
+        d0, d1, d2 = _solve3(
+            2.0 * (e0 * I0 - a0 * e1 / e0),
+            2.0 * (-a0 * e2 / e0 - D2 * e3 + e3 * D1),
+            2.0 * (-a0 * e3 / e0 + D1 * e2 - e2 * D2),
+            2.0 * (-a1 * e1 / e0 + D2 * e3 - e3 * D0),
+            2.0 * (e0 * I1 - a1 * e2 / e0),
+            2.0 * (-a1 * e3 / e0 - D0 * e1 + e1 * D2),
+            2.0 * (-a2 * e1 / e0 - D1 * e2 + e2 * D0),
+            2.0 * (-a2 * e2 / e0 + D0 * e1 - e1 * D1),
+            2.0 * (e0 * I2 - a2 * e3 / e0),
+            2.0 * (e0 * a0 + c0) - h * m0,
+            2.0 * (e0 * a1 + c1) - h * m1,
+            2.0 * (e0 * a2 + c2) - h * m2,
+        )  # fmt: skip
+        e1, e2, e3 = e1 - d0, e2 - d1, e3 - d2
+        size = e1 * e1 + e2 * e2 + e3 * e3
+        if not size < 1.0:  # also NaN
+            return False
+        if d0 * d0 + d1 * d1 + d2 * d2 <= NEWTON_TOL * NEWTON_TOL * size:
+            converged = True
+            break
+    e0 = math.sqrt(1.0 - (e1 * e1 + e2 * e2 + e3 * e3))
+    _times_matrix(
+        Rp,
+        1 - 2 * (e2 * e2 + e3 * e3), 2 * (e1 * e2 - e0 * e3), 2 * (e1 * e3 + e0 * e2),
+        2 * (e1 * e2 + e0 * e3), 1 - 2 * (e1 * e1 + e3 * e3), 2 * (e2 * e3 - e0 * e1),
+        2 * (e1 * e3 - e0 * e2), 2 * (e2 * e3 + e0 * e1), 1 - 2 * (e1 * e1 + e2 * e2),
+    )  # fmt: skip
+    return converged
+
+
+@njit(**_JIT)
+def _kick(problem, z, Rp, s):
+    """``(p, L) += s (F, τ)`` at the state ``(z, R_p)``; body vectors ``r`` are turned by
+    ``R r = R_p (Pᵀ r)``."""
+    P = problem.axes
+    for c in range(3):
+        z[3 + c] += s * problem.F[c]
+        z[6 + c] += s * problem.tau[c]
+    points, point_forces = problem.points, problem.point_forces
+    for k in range(points.shape[0]):
+        r0, r1, r2 = _apply(Rp, *_apply_transpose(P, points[k, 0], points[k, 1], points[k, 2]))
+        f0, f1, f2 = point_forces[k, 0], point_forces[k, 1], point_forces[k, 2]
+        t0, t1, t2 = _cross(r0, r1, r2, f0, f1, f2)
+        z[3] += s * f0
+        z[4] += s * f1
+        z[5] += s * f2
+        z[6] += s * t0
+        z[7] += s * t1
+        z[8] += s * t2
+
+
+@njit(**_JIT)
+def _split_record(z, Rp, P, R_out, Y_out):
+    """``R = R_p Pᵀ`` and ``Y = z``."""
+    for r in range(3):
+        for c in range(3):
+            R_out[r, c] = Rp[r, 0] * P[c, 0] + Rp[r, 1] * P[c, 1] + Rp[r, 2] * P[c, 2]
+    Y_out[:] = z
+
+
+def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
+    """Steps ``k0+1 … k1`` of ``grid`` for one ``split`` method (``FLOW``, bound).
+
+    Each step is :func:`tumble.rigid.geometric.split_step`: for each composition weight
+    ``w`` (``problem.b``), with ``s = w h``,
+
+    .. math:: (p, L) \\mathrel{+}= \\tfrac{s}{2}(F, \\tau),\\quad x \\mathrel{+}= s\\,p/m,
+              \\quad R_p \\leftarrow \\Phi_s(R_p; L),\\quad
+              (p, L) \\mathrel{+}= \\tfrac{s}{2}(F, \\tau).
+
+    ``z = (x, p, L)`` and ``Rn = R_p`` hold the state and are updated in place. Returns
+    ``(recorded, failed, cause)`` as :func:`_loop`; a failed step leaves the state at the
+    step before.
+    """
+    t_a, t_b, h, n = grid
+    weights, mass = problem.b, problem.m
+    saved, R_saved = np.empty(9), np.empty((3, 3))
+    count, until_record = 0, every - (step0 + k0) % every
+    for k in range(k0 + 1, k1 + 1):
+        t_old = t_a + (k - 1) * h
+        hk = (t_b if k == n else t_a + k * h) - t_old
+        saved[:] = z
+        R_saved[:, :] = Rn
+        converged = True
+        for w in weights:
+            s = w * hk
+            _kick(problem, z, Rn, 0.5 * s)
+            for c in range(3):
+                z[c] += s * z[3 + c] / mass
+            converged = FLOW(Rn, z[6], z[7], z[8], problem.moments, s) and converged  # noqa: F821
+            _kick(problem, z, Rn, 0.5 * s)
+        finite = True
+        for q in range(9):
+            finite = finite and math.isfinite(z[q])
+        for r in range(3):
+            for c in range(3):
+                finite = finite and math.isfinite(Rn[r, c])
+        if not (finite and converged):
+            z[:] = saved
+            Rn[:, :] = R_saved
+            return count, k, NON_FINITE if not finite else UNCONVERGED
+        until_record -= 1
+        if until_record == 0:
+            records.t[count] = t_old + hk
+            _split_record(z, Rn, problem.axes, records.R[count], records.Y[count])
+            count += 1
+            until_record = every
+    return count, -1, NON_FINITE
+
+
+def _for_flow(name: str, flow) -> CompiledChart:
+    loop = njit(**_JIT)(_bind(_split_loop, f"_split_loop_{name}", FLOW=flow))
+    batch = njit(parallel=True, **_JIT)(_bind(_batch, f"_batch_split_{name}", LOOP=loop))
+    return CompiledChart(loop, batch)
+
+
+COMPILED_FLOWS: dict[str, CompiledChart] = {
+    "axes": _for_flow("axes", _axes_flow),
+    "midpoint": _for_flow("midpoint", _midpoint_flow),
+    "dmv": _for_flow("dmv", _dmv_flow),
+}
+"""Each flow of :data:`tumble.rigid.geometric.FLOWS`, compiled in a ``split`` loop."""

@@ -19,6 +19,29 @@ name                    family    tableau     what it is
                                               Dormand–Prince's DOP853: order 8
 ``rkmk45``              lie       Fehlberg    adaptive RKMK with Fehlberg's 4(5) pair
 ======================  ========  ==========  =================================================
+
+The geometric methods (family ``split``) are splittings, not tableaux: each step is
+``K(h/2) ∘ D(h) ∘ K(h/2)``, a kick of the loads ``(p, L) += (h/2)(F, τ)`` around a drift
+``x += h p/m`` with the free body's rotation advanced by the method's *flow*; a composition
+(Yoshida 1990) raises the order of that symmetric step to 4. :mod:`tumble.rigid.geometric`
+has the flows and their sources.
+
+======================  ========  ==========  =================================================
+name                    family    flow        what it is
+======================  ========  ==========  =================================================
+``split-axes``          split     axes        rotations about the principal axes in turn
+                                              (McLachlan 1993, Reich 1994): explicit, order 2
+``split-axes4``         split     axes        ``split-axes`` composed by Yoshida: order 4
+``midpoint-lp``         split     midpoint    implicit midpoint rule on the Lie–Poisson
+                                              equation, Cayley map for R: keeps the energy
+``dmv``                 split     dmv         discrete Moser–Veselov (Moser–Veselov 1991):
+                                              keeps the energy
+======================  ========  ==========  =================================================
+
+All four are symplectic (with conservative loads), keep ``|L|`` and stay on SO(3); without
+loads the energy error stays bounded over any number of steps, and ``midpoint-lp`` and
+``dmv`` keep it exactly (a quadratic invariant of the midpoint rule; an integral of the
+Moser–Veselov map).
 """
 
 from __future__ import annotations
@@ -27,6 +50,15 @@ from dataclasses import dataclass
 
 from tumble import _checks
 from tumble.ode.tableaux import DORMAND_PRINCE8, EULER, FEHLBERG45, RK4, ButcherTableau
+
+_CUBE_ROOT_2 = 2.0 ** (1.0 / 3.0)
+YOSHIDA4 = (
+    1.0 / (2.0 - _CUBE_ROOT_2),
+    -_CUBE_ROOT_2 / (2.0 - _CUBE_ROOT_2),
+    1.0 / (2.0 - _CUBE_ROOT_2),
+)
+"""Yoshida's triple jump: ``S(γ₁h) S(γ₂h) S(γ₁h)`` of a symmetric order-2 step ``S`` has
+order 4 (H. Yoshida, Phys. Lett. A 150 (1990) 262–268, eq. 4.14)."""
 
 
 @dataclass(frozen=True)
@@ -37,47 +69,69 @@ class Method:
     ----------
     name : str
         The name ``simulate`` takes.
-    family : {"matrix", "quat", "lie"}
+    family : {"matrix", "quat", "lie", "split"}
         ``matrix``: the nine entries of R in the state; ``quat``: a quaternion, renormalised
-        after each step; ``lie``: RKMK in the local chart ``R = R_n exp(û)``.
-    tableau : ButcherTableau
-        The Runge–Kutta coefficients (the ODE core's).
+        after each step; ``lie``: RKMK in the local chart ``R = R_n exp(û)``; ``split``: a
+        splitting of kicks and a free-body flow (module docstring).
+    tableau : ButcherTableau, optional
+        The Runge–Kutta coefficients (the ODE core's); None for the ``split`` family.
     dexpinv : bool
         For the ``lie`` family: whether the stages are corrected by ``dexp⁻¹`` (True for a
         true RKMK method; False only for ``seed-rk4``).
     order_override : int, optional
         The method's order on a general body, when it differs from the tableau's
-        (``seed-rk4``: 2). Tests measure it.
+        (``seed-rk4``: 2), or of a ``split`` method. Tests measure it.
+    flow : {"axes", "midpoint", "dmv"}, optional
+        For the ``split`` family: how the free body's rotation is advanced
+        (:data:`tumble.rigid.geometric.FLOWS`).
+    weights : tuple of float
+        For the ``split`` family: the composition ``S(w₁h) ∘ S(w₂h) ∘ …`` of the symmetric
+        step ``S`` (``(1,)``: one step; :data:`YOSHIDA4`: order 4).
     """
 
     name: str
     family: str
-    tableau: ButcherTableau
+    tableau: ButcherTableau | None = None
     dexpinv: bool = True
     order_override: int | None = None
+    flow: str | None = None
+    weights: tuple[float, ...] = (1.0,)
 
     @property
     def order(self) -> int:
         """The convergence order the method claims (and the tests measure)."""
-        return self.tableau.order if self.order_override is None else self.order_override
+        if self.order_override is not None:
+            return self.order_override
+        assert self.tableau is not None, "a split method declares its order"
+        return self.tableau.order
 
     @property
     def conserves(self) -> frozenset[str]:
         """The invariants kept to round-off on a torque-free body.
 
-        ``"angular_momentum"``: every method steps ``L̇ = τ`` linearly, so without torque
-        ``L`` is constant; ``"orthogonality"``: R stays a rotation (``lie`` and ``quat``
-        families, which never leave SO(3) or renormalise onto it).
+        ``"angular_momentum"``: every method steps ``L̇ = τ`` linearly (or kicks it), so
+        without torque ``L`` is constant; ``"orthogonality"``: R stays a rotation (``lie``,
+        ``quat`` and ``split`` families, which never leave SO(3) or renormalise onto it);
+        ``"energy"``: the kinetic energy of the free body (``midpoint-lp``, ``dmv``).
         """
         kept = {"angular_momentum"}
-        if self.family in ("lie", "quat"):
+        if self.family in ("lie", "quat", "split"):
             kept.add("orthogonality")
+        if self.flow in ("midpoint", "dmv"):
+            kept.add("energy")
         return frozenset(kept)
+
+    @property
+    def symplectic(self) -> bool:
+        """Whether the method is symplectic (and Poisson) on the rigid body: the ``split``
+        family. Its energy error then stays bounded over long runs, without loads or with
+        loads that derive from a potential (Hairer–Lubich–Wanner, ch. VI and IX)."""
+        return self.family == "split"
 
     @property
     def adaptive(self) -> bool:
         """Whether the method chooses its own steps (an embedded pair)."""
-        return self.tableau.adaptive
+        return self.tableau is not None and self.tableau.adaptive
 
 
 METHODS: dict[str, Method] = {
@@ -92,6 +146,10 @@ METHODS: dict[str, Method] = {
         Method("rkmk4", "lie", RK4),
         Method("rkmk8", "lie", DORMAND_PRINCE8),
         Method("rkmk45", "lie", FEHLBERG45),
+        Method("split-axes", "split", flow="axes", order_override=2),
+        Method("split-axes4", "split", flow="axes", weights=YOSHIDA4, order_override=4),
+        Method("midpoint-lp", "split", flow="midpoint", order_override=2),
+        Method("dmv", "split", flow="dmv", order_override=2),
     )
 }
 """Every rigid-body method by name."""

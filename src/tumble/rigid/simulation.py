@@ -12,12 +12,25 @@ from numpy.typing import ArrayLike
 from tumble import _checks
 from tumble._progress import progress_bar
 from tumble.ode.driver import Control, Jump, march
-from tumble.rigid import initial
+from tumble.rigid import geometric, initial
 from tumble.rigid.body import RigidBody
 from tumble.rigid.charts import Dynamics
-from tumble.rigid.forces import Impulse, Load, State, compiled_loads, split_loads
+from tumble.rigid.forces import (
+    Impulse,
+    Load,
+    State,
+    compiled_loads,
+    potential_energy,
+    split_loads,
+)
 from tumble.rigid.methods import Method, get_method
-from tumble.rigid.steppers import CompiledStepper, RigidStepper
+from tumble.rigid.steppers import (
+    BodyStepper,
+    CompiledSplitStepper,
+    CompiledStepper,
+    RigidStepper,
+    SplitStepper,
+)
 from tumble.rigid.trajectory import Trajectory
 
 if TYPE_CHECKING:
@@ -31,19 +44,45 @@ def _first_step(t_span: float, Y: np.ndarray, body: RigidBody, rtol: float) -> f
     return min(t_span / 10, 0.1 * rtol ** (1 / 5) / omega)
 
 
-def _jumps(stepper: RigidStepper, impulses, t0: float, t_end: float) -> list[Jump]:
+def _jumps(stepper: BodyStepper, impulses, t0: float, t_end: float) -> list[Jump]:
     """The impulses as the driver's jumps, one per distinct time in ``[t0, t_end]``."""
     times = sorted({imp.time for imp in impulses if t0 <= imp.time <= t_end})
     return [(time, stepper.kick([imp for imp in impulses if imp.time == time])) for time in times]
 
 
-def _problem(method: Method, body: RigidBody, loads) -> Problem:
+def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> Problem:
+    """The kernels' :class:`~tumble.rigid.kernels.Problem` for ``method`` and constant
+    ``loads`` (:func:`~tumble.rigid.forces.compiled_loads`); ``axes``, ``moments`` are the
+    principal frame (``split`` methods; with a leading body axis in a batch)."""
     from tumble.rigid.kernels import Problem
 
+    if method.tableau is None:
+        A, b = np.zeros((0, 0)), np.array(method.weights)
+    else:
+        A, b = method.tableau.A, method.tableau.b
     F, tau, points, point_forces = loads
-    tableau = method.tableau
-    return Problem(method.dexpinv, tableau.A, tableau.b, body.inertia_inverse, body.mass, F,
-                   tau, points, point_forces)  # fmt: skip
+    return Problem(method.dexpinv, A, b, inertia_inverse, mass, F, tau, points, point_forces,
+                   axes, moments)  # fmt: skip
+
+
+def stepper_for(method: Method, body: RigidBody, loads, kernel_loads) -> BodyStepper:
+    """The method's stepper: compiled when ``kernel_loads`` (constant loads) are given."""
+    dynamics = Dynamics(body, loads)
+    if method.family == "split":
+        if kernel_loads is None:
+            return SplitStepper(method, dynamics)
+        moments, axes = geometric.principal_frame(body.inertia)
+        return CompiledSplitStepper(
+            method, dynamics,
+            problem(method, body.inertia_inverse, body.mass, kernel_loads, axes, moments),
+        )  # fmt: skip
+    if kernel_loads is None:
+        return RigidStepper(method, dynamics)
+    eye = np.eye(3)
+    return CompiledStepper(
+        method, dynamics,
+        problem(method, body.inertia_inverse, body.mass, kernel_loads, eye, np.ones(3)),
+    )  # fmt: skip
 
 
 def simulate(
@@ -150,11 +189,7 @@ def simulate(
             remedy="the compiled kernels need a fixed-step method, constant loads and no events",
         )  # fmt: skip
     use_kernel = use_kernel if compiled is None else bool(compiled)
-    dynamics = Dynamics(body, loads)
-    if use_kernel:
-        stepper: RigidStepper = CompiledStepper(spec, dynamics, _problem(spec, body, kernel_loads))
-    else:
-        stepper = RigidStepper(spec, dynamics)
+    stepper = stepper_for(spec, body, loads, kernel_loads if use_kernel else None)
     settings = {
         "h": h,
         "rtol": rtol or None,
@@ -191,6 +226,8 @@ def simulate(
     if not out.status.success:
         log.warning("simulate stopped early: %s", out.message)
     R_samples, Y_samples, q_samples = out.records
+    with np.errstate(over="ignore", invalid="ignore"):
+        V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
     return Trajectory(
         t=out.t,
         x=Y_samples[:, :3],
@@ -206,4 +243,5 @@ def simulate(
         n_rejected=out.n_rejected,
         t_events=[np.array(ts, dtype=float) for ts in out.t_events],
         q_raw=q_samples if spec.family == "quat" else None,
+        potential_energy=V,
     )

@@ -43,10 +43,14 @@ class Trajectory:
         For each event, the times at which it fired.
     q_raw : ndarray, shape (n, 4), optional
         The quaternions the ``quat`` method carried (otherwise ``q`` comes from ``R``).
+    potential_energy : ndarray, shape (n,), optional
+        ``V`` of the loads that derive from a potential (gravity, constant forces, magnetic
+        dipoles), J; zeros without such loads (``None`` given: zeros).
 
     Notes
     -----
-    The diagnostics are computed from these on first use: ``omega_body``, ``q``, ``energy``;
+    The diagnostics are computed from these on first use: ``omega_body``, ``q``,
+    ``kinetic_energy`` and ``energy`` (kinetic plus potential);
     along the run ``orthogonality_error`` (``‖RᵀR − I‖_F``), ``quaternion_norm_error``,
     ``energy_error`` (``E − E₀``) and ``momentum_error`` (``‖L − L₀‖``); and over the run
     ``orthogonality_drift``, ``energy_drift`` and ``momentum_drift`` (the largest of each,
@@ -68,6 +72,11 @@ class Trajectory:
     n_rejected: int = 0
     t_events: list = field(default_factory=list)
     q_raw: np.ndarray | None = None
+    potential_energy: np.ndarray = None  # type: ignore[assignment]
+
+    def __post_init__(self) -> None:
+        if self.potential_energy is None:
+            self.potential_energy = np.zeros(len(self.t))
 
     @property
     def success(self) -> bool:
@@ -92,12 +101,20 @@ class Trajectory:
             return body_L @ self.body.inertia_inverse.T
 
     @cached_property
-    def energy(self) -> np.ndarray:
-        """Kinetic energy ``½ m |v|² + ½ ω·(Rᵀ L)``, shape (n,), J."""
+    def kinetic_energy(self) -> np.ndarray:
+        """Kinetic energy ``T = ½ m |v|² + ½ ω·(Rᵀ L)``, shape (n,), J."""
         with np.errstate(over="ignore", invalid="ignore"):  # a diverged run: inf, no warning
             body_L = np.einsum("nji,nj->ni", self.R, self.L_world)
             rotational = 0.5 * np.einsum("ni,ni->n", self.omega_body, body_L)
             return 0.5 * self.body.mass * np.einsum("ni,ni->n", self.v, self.v) + rotational
+
+    @cached_property
+    def energy(self) -> np.ndarray:
+        """Total energy ``T + V``, shape (n,), J: :attr:`kinetic_energy` plus
+        :attr:`potential_energy` (the loads that have a potential; a torque or a callable
+        load has none, so with one of those this is not an invariant)."""
+        with np.errstate(over="ignore", invalid="ignore"):
+            return self.kinetic_energy + self.potential_energy
 
     @cached_property
     def orthogonality_error(self) -> np.ndarray:
@@ -108,7 +125,7 @@ class Trajectory:
 
     @cached_property
     def energy_error(self) -> np.ndarray:
-        """``E − E₀``, shape (n,), J: the kinetic energy's change since the first sample."""
+        """``E − E₀``, shape (n,), J: the total energy's change since the first sample."""
         with np.errstate(over="ignore", invalid="ignore"):
             return self.energy - self.energy[0]
 
