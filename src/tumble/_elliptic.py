@@ -196,6 +196,76 @@ def _phase(cn0: float, sn0: float, m1: float) -> float:
     return float(incomplete_first(np.arctan2(-sn0, -cn0), m1)) + shift
 
 
+@dataclass(frozen=True)
+class SeparatrixMotion:
+    """ω(t) on the separatrix ``|L|² = 2EB`` (``m = 1``), in the sorted principal frame.
+
+    The limit of regime C as ``m → 1``: ``sn → tanh``, ``cn, dn → sech`` and the period goes
+    to infinity, so ``ω_A = s a_A sech u``, ``ω_B = s σ a_B tanh u``, ``ω_C = σ a_C sech u``
+    with ``u = u0 + λ t`` (``s`` = sign ω_A(0), the half period the elliptic form would shift
+    by). The body approaches the middle axis as ``t → ±∞``. The precession integral is
+    elementary, ``∫₀ᵘ du/(1 + ν tanh²u) = (u + √ν arctan(√ν tanh u))/(1 + ν)``.
+    """
+
+    moments: np.ndarray
+    amplitudes: np.ndarray
+    sign: float  # σ = sign ω_C(0)
+    side: float  # s = sign ω_A(0)
+    rate: float
+    u0: float
+    pole: int = 2
+
+    def omega(self, t: np.ndarray) -> np.ndarray:
+        u = self.u0 + self.rate * np.asarray(t, dtype=float)
+        sech, tanh = 1.0 / np.cosh(u), np.tanh(u)
+        a_a, a_b, a_c = self.amplitudes
+        return np.stack(
+            [self.side * a_a * sech, self.side * self.sign * a_b * tanh, self.sign * a_c * sech],
+            axis=-1,
+        )
+
+    def precession(self, t: np.ndarray, momentum: float) -> np.ndarray:
+        a, b, c = self.moments
+        nu = c * (b - a) / (a * (c - b))
+        root = np.sqrt(nu)
+
+        def integral(u):
+            return (u + root * np.arctan(root * np.tanh(u))) / (1.0 + nu)
+
+        u = self.u0 + self.rate * np.asarray(t, dtype=float)
+        scale = momentum * (c - a) / (a * c * self.rate)
+        return momentum * t / c + scale * (integral(u) - integral(self.u0))
+
+
+def separatrix_motion(moments: np.ndarray, omega0: np.ndarray) -> SeparatrixMotion:
+    """The motion from ω(0) on the separatrix (regime C's formulas at ``m = 1``)."""
+    a, b, c = moments
+    w_a, w_b, w_c = omega0
+    s_p = np.hypot(np.sqrt(a * (c - a)) * w_a, np.sqrt(b * (c - b)) * w_b)
+    s_q = np.hypot(np.sqrt(b * (b - a)) * w_b, np.sqrt(c * (c - a)) * w_c)
+    amplitudes = np.array([s_p / np.sqrt(a * (c - a)), s_p / np.sqrt(b * (c - b)),
+                           s_q / np.sqrt(c * (c - a))])  # fmt: skip
+    sign = 1.0 if w_c >= 0.0 else -1.0
+    side = 1.0 if w_a >= 0.0 else -1.0
+    rate = s_q * np.sqrt((c - b) / (a * b * c))
+    tanh0 = np.clip(side * sign * w_b / amplitudes[1], -1.0, 1.0) if amplitudes[1] > 0 else 0.0
+    return SeparatrixMotion(moments, amplitudes, sign, side, rate, float(np.arctanh(tanh0)))
+
+
+def flow_rotation(moments: np.ndarray, omega: np.ndarray, R0: np.ndarray, h: float) -> np.ndarray:
+    """R(h) from ``R(0) = R0``, ω(0) = ``omega``, in the sorted principal frame (one step of
+    the exact flow): every case of :func:`classify`, and on the separatrix (to
+    ``SEPARATRIX_RTOL``, where the elliptic form refuses) its ``m = 1`` limit."""
+    t = np.array([float(h)])
+    eye = np.eye(3)
+    try:
+        return body_rotation(moments, eye, omega, R0, t)[0]
+    except ValueError:
+        if classify(moments, eye, omega, for_period=True)[0] != "separatrix":
+            raise
+    return elliptic_rotation(separatrix_motion(moments, omega), moments, eye, R0, t, omega)[0]
+
+
 def classify(
     moments: np.ndarray, axes: np.ndarray, omega0: np.ndarray, for_period: bool = False
 ) -> tuple:
@@ -262,18 +332,24 @@ def body_rotation(
         axis, rate, transverse = data
         momentum = R0 @ axes @ (moments * (axes.T @ omega0))
         return rodrigues(momentum / transverse, t) @ R0 @ rodrigues(rate * axis, t)
-    return elliptic_rotation(data, moments, axes, R0, t)
+    return elliptic_rotation(data, moments, axes, R0, t, axes.T @ omega0)
 
 
 def elliptic_rotation(
-    motion: EllipticMotion, moments: np.ndarray, axes: np.ndarray, R0: np.ndarray, t: np.ndarray
+    motion: EllipticMotion | SeparatrixMotion,
+    moments: np.ndarray,
+    axes: np.ndarray,
+    R0: np.ndarray,
+    t: np.ndarray,
+    omega0: np.ndarray,
 ) -> np.ndarray:
-    """R(t) = W Rz(φ) M(l) Pᵀ of `free_body_rotation` for the asymmetric body."""
+    """R(t) = W Rz(φ) M(l) Pᵀ of `free_body_rotation` for the asymmetric body; ``omega0``
+    is ω(0) in the sorted principal frame (l(0) is taken from it, not from the formulas)."""
     order = [0, 1, 2] if motion.pole == 2 else [1, 2, 0]  # (q, r, p), cyclic: P is proper
     pole_axes = axes[:, order]
-    momenta = moments[order] * np.vstack([motion.omega(np.zeros(1)), motion.omega(t)])[:, order]
+    momenta = moments[order] * np.vstack([omega0, motion.omega(t)])[:, order]
     norm = np.linalg.norm(momenta[0])
-    frames = pole_frames(momenta / norm)
+    frames = pole_frames(momenta / np.linalg.norm(momenta, axis=1, keepdims=True))
     phi = motion.precession(t, float(norm))
     c, s = np.cos(phi), np.sin(phi)
     spin = np.zeros((t.size, 3, 3))

@@ -32,7 +32,7 @@ from tumble.rigid.forces import (
     split_loads,
 )
 from tumble.rigid.methods import METHODS, Method, get_method
-from tumble.rigid.simulation import problem
+from tumble.rigid.simulation import check_free, problem
 from tumble.rigid.steppers import unconverged_message
 from tumble.rigid.trajectory import Trajectory
 
@@ -445,6 +445,7 @@ def simulate_batch(
     bodies = bodies * n_bodies if one_body else bodies
     R, Y = _initial_states(bodies, rows["R0"], rows["q0"], rows["omega0"], rows["L0"],
                            rows["x0"], rows["v0"], n_bodies)  # fmt: skip
+    check_free(spec, split_loads(forces)[0])
     loads = _kernel_loads(forces, bodies)
     settings = {"h": h, "rtol": None, "atol": None, "record_every": every, "compiled": True}
     batch = _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings)

@@ -36,16 +36,23 @@ name                    family    flow        what it is
                                               equation, Cayley map for R: keeps the energy
 ``dmv``                 split     dmv         discrete Moser–Veselov (Moser–Veselov 1991):
                                               keeps the energy
+``exact``               split     exact       the exact free-body flow (Jacobi's elliptic
+                                              functions): round-off at any h; no loads
+``strang``              split     exact       Strang splitting of loads and the exact flow:
+                                              order 2
+``yoshida4``            split     exact       ``strang`` composed by Yoshida: order 4
 ======================  ========  ==========  =================================================
 
-All four are symplectic (with conservative loads), keep ``|L|`` and stay on SO(3); without
-loads the energy error stays bounded over any number of steps, and ``midpoint-lp`` and
-``dmv`` keep it exactly (a quadratic invariant of the midpoint rule; an integral of the
-Moser–Veselov map).
+All are symplectic (with conservative loads), keep ``|L|`` and stay on SO(3); without
+loads the energy error stays bounded over any number of steps, and ``midpoint-lp``,
+``dmv`` and the three on the exact flow keep it exactly (a quadratic invariant of the
+midpoint rule; an integral of the Moser–Veselov map; the exact solution). With loads,
+``split-axes`` is the Strang splitting on the axes flow, ``strang`` on the exact one.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from tumble import _checks
@@ -98,10 +105,19 @@ class Method:
     weights: tuple[float, ...] = (1.0,)
 
     @property
-    def order(self) -> int:
-        """The convergence order the method claims (and the tests measure)."""
+    def exact(self) -> bool:
+        """Whether the method is the exact flow itself (``exact``): its error is round-off
+        whatever h, so it has no order (:attr:`order` is ``inf``) and takes no loads."""
+        return self.flow == "exact" and self.order_override is None
+
+    @property
+    def order(self) -> float:
+        """The convergence order the method claims (and the tests measure); ``inf`` for the
+        exact flow."""
         if self.order_override is not None:
             return self.order_override
+        if self.exact:
+            return math.inf
         assert self.tableau is not None, "a split method declares its order"
         return self.tableau.order
 
@@ -112,12 +128,13 @@ class Method:
         ``"angular_momentum"``: every method steps ``L̇ = τ`` linearly (or kicks it), so
         without torque ``L`` is constant; ``"orthogonality"``: R stays a rotation (``lie``,
         ``quat`` and ``split`` families, which never leave SO(3) or renormalise onto it);
-        ``"energy"``: the kinetic energy of the free body (``midpoint-lp``, ``dmv``).
+        ``"energy"``: the kinetic energy of the free body (``midpoint-lp``, ``dmv`` and the
+        methods on the exact flow).
         """
         kept = {"angular_momentum"}
         if self.family in ("lie", "quat", "split"):
             kept.add("orthogonality")
-        if self.flow in ("midpoint", "dmv"):
+        if self.flow in ("midpoint", "dmv", "exact"):
             kept.add("energy")
         return frozenset(kept)
 
@@ -150,6 +167,9 @@ METHODS: dict[str, Method] = {
         Method("split-axes4", "split", flow="axes", weights=YOSHIDA4, order_override=4),
         Method("midpoint-lp", "split", flow="midpoint", order_override=2),
         Method("dmv", "split", flow="dmv", order_override=2),
+        Method("exact", "split", flow="exact"),
+        Method("strang", "split", flow="exact", order_override=2),
+        Method("yoshida4", "split", flow="exact", weights=YOSHIDA4, order_override=4),
     )
 }
 """Every rigid-body method by name."""

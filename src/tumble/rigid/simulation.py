@@ -65,6 +65,17 @@ def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> Prob
                    axes, moments)  # fmt: skip
 
 
+def check_free(method: Method, loads) -> None:
+    """The exact flow takes no continuous load: a ValueError pointing to the splittings."""
+    if method.exact and loads:
+        raise _checks.fail(
+            "forces", [type(load).__name__ for load in loads],
+            f"no continuous loads with method={method.name!r} (impulses are allowed)",
+            remedy="the exact flow is the torque-free body's; with loads use 'strang' or "
+            "'yoshida4' (the exact flow split with kicks of the loads, order 2 and 4)",
+        )  # fmt: skip
+
+
 def stepper_for(method: Method, body: RigidBody, loads, kernel_loads) -> BodyStepper:
     """The method's stepper: compiled when ``kernel_loads`` (constant loads) are given."""
     dynamics = Dynamics(body, loads)
@@ -180,6 +191,7 @@ def simulate(
     R, Y = initial.initial_state(body, x0, v0, R0, q0, omega0, L0)
     record_every = _checks.count("record_every", record_every)
     loads, impulses = split_loads(forces)
+    check_free(spec, loads)
     events = list(events)
     kernel_loads = compiled_loads(loads, body.mass)
     use_kernel = not spec.adaptive and kernel_loads is not None and not events

@@ -36,7 +36,9 @@ def method_names(methods: Sequence[str] | str) -> tuple[str, ...]:
 
 
 def fixed_step_methods(*, max_order: int | None = None) -> tuple[str, ...]:
-    """Names of the methods of :data:`tumble.rigid.METHODS` that take a fixed step, in order.
+    """Names of the methods of :data:`tumble.rigid.METHODS` that take a fixed step and have an
+    order in h on the torque-free body, in order (not the adaptive one, nor those on the exact
+    flow, whose error there is round-off at any h).
 
     Parameters
     ----------
@@ -51,7 +53,9 @@ def fixed_step_methods(*, max_order: int | None = None) -> tuple[str, ...]:
     return tuple(
         name
         for name, method in METHODS.items()
-        if not method.adaptive and (max_order is None or method.order <= max_order)
+        if not method.adaptive
+        and method.flow != "exact"
+        and (max_order is None or method.order <= max_order)
     )
 
 

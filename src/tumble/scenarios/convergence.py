@@ -200,8 +200,10 @@ def _check_fixed_step(argument: str, value, method) -> None:
     """A ValueError naming ``argument`` unless ``method`` is a fixed-step method."""
     if method in FIXED_STEP_METHODS:
         return
-    if isinstance(method, str) and method in METHODS:
+    if isinstance(method, str) and method in METHODS and METHODS[method].adaptive:
         why = "is adaptive: h is only its first step, so its error has no order in h"
+    elif isinstance(method, str) and method in METHODS:
+        why = "steps the exact flow: on the torque-free body its error is round-off at any h"
     else:
         why = "is not a rigid-body method"
     raise _checks.fail(

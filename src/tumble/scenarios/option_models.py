@@ -62,9 +62,9 @@ def _rigid_methods() -> list[str]:
 
 
 def _fixed_step_rigid_methods() -> list[str]:
-    from tumble.rigid import METHODS
+    from tumble.scenarios._common import fixed_step_methods
 
-    return [name for name, method in METHODS.items() if not method.adaptive]
+    return list(fixed_step_methods())
 
 
 def _ode_methods() -> list[str]:
