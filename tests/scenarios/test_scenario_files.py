@@ -365,7 +365,7 @@ def test_inside_out_mesh_is_refused_with_the_key(tmp_path):
 
 def test_unknown_scenario_in_check_options_lists_the_known_ones():
     with pytest.raises(ValueError, match="allowed: beam, .*rigid-body.*torus-spin"):
-        check_options("spinning-top", {})
+        check_options("spinning-plate", {})
 
 
 def test_check_options_refuses_options_that_are_not_a_table():

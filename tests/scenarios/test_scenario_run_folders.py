@@ -17,6 +17,7 @@ SHORT = {
     "t-handle": {"t_end": 2.0, "spins": [[1.0, 0.05, 0.0]]},
     "convergence": {"step_counts": [50, 100], "methods": ["rkmk4"]},
     "beam": {"n_elements": 8, "n_steps": 200, "sweep_steps": 100},
+    "spinning-top": {"t_end": 0.5},
 }
 RIGID = {"animation.gif", "view.html", "data.nc"}
 PROMISED = {
@@ -30,6 +31,7 @@ PROMISED = {
     "convergence": {"convergence.png", "data.nc"},
     "beam": {f"energy_{s}.png" for s in ("explicit", "semi-implicit", "implicit", "midpoint")}
     | {"stability_sweep.png", "beam_shapes.png", "animation.gif", "data.nc"},
+    "spinning-top": {"top.png", "invariants.png"} | RIGID,
 }  # fmt: skip
 
 

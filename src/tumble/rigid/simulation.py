@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
@@ -24,6 +25,7 @@ from tumble.rigid.forces import (
     split_loads,
 )
 from tumble.rigid.methods import Method, get_method
+from tumble.rigid.pivot import centre_of_mass_motion, pivot_body, pivot_forces
 from tumble.rigid.steppers import (
     BodyStepper,
     CompiledSplitStepper,
@@ -116,6 +118,7 @@ def simulate(
     progress: bool = False,
     record_every: int = 1,
     compiled: bool | None = None,
+    pivot: ArrayLike | None = None,
 ) -> Trajectory:
     """Simulate a rigid body from ``t0`` to ``t_end``.
 
@@ -165,6 +168,14 @@ def simulate(
     compiled : bool, optional
         Force (True) or forbid (False) the numba kernels; by default they run whenever the
         method has a fixed step, every load is a constant and there are no events.
+    pivot : array_like, shape (3,), optional
+        A point of the body held fixed in space (body coordinates from the centre of mass, m):
+        the heavy top. The body turns about it with its inertia there (parallel axis) under
+        the loads' torques about it (:mod:`tumble.rigid.pivot`); ``x0`` is the initial centre
+        of mass, ``v0`` must be None (it follows from ω), ``L0`` is taken about the pivot, and
+        loads must be constants. The trajectory's ``x``, ``v`` and ``L_world`` are the centre
+        of mass's, as without a pivot; :meth:`Trajectory.angular_momentum_about
+        <tumble.rigid.trajectory.Trajectory.angular_momentum_about>` gives ``L`` about it.
 
     Returns
     -------
@@ -185,6 +196,12 @@ def simulate(
     >>> len(run.t), round(float(run.R[-1, 1, 1]), 12) == round(float(np.cos(1.0)), 12)
     (11, True)
     """
+    if pivot is not None:
+        return _about_pivot(
+            body, t_end, pivot, method=method, h=h, rtol=rtol, atol=atol, t0=t0, x0=x0, v0=v0,
+            R0=R0, q0=q0, omega0=omega0, L0=L0, forces=forces, events=events,
+            progress=progress, record_every=record_every, compiled=compiled,
+        )  # fmt: skip
     spec = get_method(method)
     t0, t_end = initial.check_times(t0, t_end)
     h, rtol, atol = initial.check_steps(spec, h, rtol, atol)
@@ -257,3 +274,30 @@ def simulate(
         q_raw=q_samples if spec.family == "quat" else None,
         potential_energy=V,
     )
+
+
+def _about_pivot(body: RigidBody, t_end: float, pivot: ArrayLike, *, x0, v0, R0, q0, forces,
+                 **options) -> Trajectory:  # fmt: skip
+    """``simulate`` with ``pivot``: the reduced body about it (:mod:`tumble.rigid.pivot`)."""
+    if not isinstance(body, RigidBody):
+        raise _checks.fail("body", body, "a tumble.RigidBody")
+    point = _checks.array("pivot", pivot, shape=(3,), unit="m")
+    if v0 is not None:
+        raise _checks.fail(
+            "v0", v0, "None with a pivot",
+            remedy="the centre of mass moves as the body turns: v = ω × (x − x_pivot)",
+        )  # fmt: skip
+    loads, _ = split_loads(forces)
+    check_free(get_method(options["method"]), loads)
+    R_start = initial.initial_attitude(R0, q0)
+    x_start = np.zeros(3) if x0 is None else _checks.array("x0", x0, shape=(3,), unit="m")
+    x_pivot = x_start + R_start @ point
+    reduced = pivot_body(body, point)
+    run = simulate(reduced, t_end, x0=x_pivot, R0=R_start,
+                   forces=pivot_forces(forces, body.mass, point, x_pivot), **options)  # fmt: skip
+    x, v, L = centre_of_mass_motion(body, reduced, point, x_pivot, run.R, run.L_world)
+    with np.errstate(over="ignore", invalid="ignore"):
+        V = potential_energy(loads, x, run.R, body.mass)
+    settings = {**run.settings, "pivot": point.tolist()}
+    return dataclasses.replace(run, x=x, v=v, L_world=L, body=body, settings=settings,
+                               potential_energy=V)  # fmt: skip

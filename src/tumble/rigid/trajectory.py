@@ -174,6 +174,20 @@ class Trajectory:
             return np.zeros(len(self.t))
         return np.linalg.norm(self.q_raw, axis=1) - 1.0
 
+    def angular_momentum_about(self, point) -> np.ndarray:
+        """World angular momentum about a fixed world ``point``, ``L + m (x − point) × v``,
+        shape (n, 3), kg m²/s: for a body with a pivot, ``point`` is the pivot.
+
+        Examples
+        --------
+        >>> from tumble.rigid import RigidBody, simulate
+        >>> run = simulate(RigidBody(2.0, [1.0, 1.0, 1.0]), 1.0, h=0.1, v0=(1.0, 0.0, 0.0))
+        >>> run.angular_momentum_about((0.0, 1.0, 0.0))[-1]  # 2 (1, −1, 0) × (1, 0, 0)
+        array([0., 0., 2.])
+        """
+        arm = self.x - np.asarray(point, dtype=float)
+        return self.L_world + self.body.mass * np.cross(arm, self.v)
+
     def euler_zyx(self) -> np.ndarray:
         """ZYX Euler angles ``(φ_z, θ_y, ψ_x)`` in rad, shape (n, 3); see :mod:`tumble.so3`."""
         return so3.euler_zyx_from_matrix(self.R)

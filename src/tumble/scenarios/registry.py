@@ -21,6 +21,7 @@ _MODULES = {
     "convergence": "tumble.scenarios.convergence",
     "beam": "tumble.scenarios.beam",
     "rigid-body": "tumble.scenarios.rigid_body",
+    "spinning-top": "tumble.scenarios.spinning_top",
 }
 
 
