@@ -364,3 +364,17 @@ def test_compiled_carlson_integrals_match_scipy():
         assert kernels._carlson_rf(x, y, z) == pytest.approx(elliprf(x, y, z), rel=4e-15)
         assert kernels._carlson_rj(x, y, z, p) == pytest.approx(elliprj(x, y, z, p), rel=4e-15)
     assert kernels._carlson_rf(0.0, 1e-300, 1.0) == pytest.approx(elliprf(0.0, 1e-300, 1.0))
+
+
+@pytest.mark.parametrize("method", ON_EXACT)
+def test_a_batch_on_the_exact_flow_is_its_single_runs(method):
+    from tumble.rigid import simulate_batch
+
+    bodies = [RigidBody(1.0, INERTIA, allow_unphysical=True), exact_body(None),
+              RigidBody(2.0, [[2.0, 0.1, 0.0], [0.1, 1.5, 0.05], [0.0, 0.05, 1.0]])]  # fmt: skip
+    omega0 = np.array([P1_OMEGA0, SPINS[0], (0.3, 1.0, -0.2)])
+    batch = simulate_batch(bodies, 10.0, method=method, h=0.5, omega0=omega0, record_every=3)
+    for k, body in enumerate(bodies):
+        single = simulate(body, 10.0, method=method, h=0.5, omega0=omega0[k], record_every=3)
+        np.testing.assert_array_equal(batch[k].R, single.R)
+        np.testing.assert_array_equal(batch[k].L_world, single.L_world)

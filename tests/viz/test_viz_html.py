@@ -101,7 +101,7 @@ def test_first_frame_is_the_initial_picture(mesh, figure):
 
 def test_frames_update_every_trace_but_the_energy_curve(figure):
     names = [trace.name for trace in figure.data]
-    updated = [k for k, name in enumerate(names) if name != "kinetic energy"]
+    updated = [k for k, name in enumerate(names) if name != "energy"]
     for frame in figure.frames:
         assert list(frame.traces) == updated
         assert [trace.type for trace in frame.data] == [figure.data[k].type for k in updated]
@@ -127,7 +127,7 @@ def test_play_and_pause_buttons_animate(figure):
 
 
 def test_energy_trace_matches_trajectory(run, figure):
-    curve = next(trace for trace in figure.data if trace.name == "kinetic energy")
+    curve = next(trace for trace in figure.data if trace.name == "energy")
     np.testing.assert_array_equal(curve.x, run.t)
     np.testing.assert_array_equal(curve.y, run.energy)
     assert (curve.xaxis, curve.yaxis) == ("x", "y")

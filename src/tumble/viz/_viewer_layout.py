@@ -59,7 +59,7 @@ def style_arrow(line, cone) -> tuple:
 
 
 def energy_curve(t: np.ndarray, energy: np.ndarray):
-    """Kinetic energy (J) against time (s), thinned to about :data:`ENERGY_POINTS` samples."""
+    """Energy ``T + V`` (J) against time (s), thinned to about :data:`ENERGY_POINTS` samples."""
     import plotly.graph_objects as go
 
     keep = np.arange(0, len(t), max(1, -(-len(t) // ENERGY_POINTS)))
@@ -69,7 +69,7 @@ def energy_curve(t: np.ndarray, energy: np.ndarray):
         y=energy[keep],
         mode="lines",
         line={"color": MESH_COLOR, "width": 2},
-        name="kinetic energy",
+        name="energy",
         hovertemplate="t = %{x:.4g} s<br>E = %{y:.8g} J<extra></extra>",
     )
 
@@ -124,7 +124,7 @@ def apply_layout(fig, title: str, times, world: np.ndarray, arrows, energy_range
         },
         xaxis={"title": {"text": "t (s)"}, "range": [float(times[0]), float(times[-1])]},
         yaxis={
-            "title": {"text": "kinetic energy (J)"},
+            "title": {"text": "energy T + V (J)"},
             "range": energy_range,
             "domain": [0.0, ENERGY_TOP],
             "exponentformat": "e",

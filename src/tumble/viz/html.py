@@ -3,7 +3,7 @@
 :func:`html_viewer` writes one self-contained page (plotly, with plotly.js inlined, so it
 opens with no network): on top a 3D scene with the body's mesh at the chosen time, drawn on
 fixed equal-aspect axes that hold the whole run; under it a Play/Pause button and a time
-slider; at the bottom the kinetic energy against time with a marker at the current time.
+slider; at the bottom the energy ``T + V`` against time with a marker at the current time.
 :func:`viewer_figure` returns the same plotly figure without writing it.
 
 The world vertices at sample ``k`` are ``x[k] + R[k] v`` for each body-frame vertex ``v``.
