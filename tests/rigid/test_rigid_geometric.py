@@ -378,3 +378,16 @@ def test_a_batch_on_the_exact_flow_is_its_single_runs(method):
         single = simulate(body, 10.0, method=method, h=0.5, omega0=omega0[k], record_every=3)
         np.testing.assert_array_equal(batch[k].R, single.R)
         np.testing.assert_array_equal(batch[k].L_world, single.L_world)
+
+
+@pytest.mark.parametrize(
+    "moments", [(1.0, 2.0, 3.0), (3.0, 1.0, 2.0), (2.0, 3.0, 1.0), (1.0, 3.0, 2.0),
+                (3.0, 2.0, 1.0), (2.0, 1.0, 3.0), (1.0, 1.0, 2.0), (2.0, 1.0, 1.0)],
+)  # fmt: skip
+def test_the_fast_principal_frame_of_a_diagonal_inertia_is_the_general_one(moments):
+    from tumble._elliptic import principal_axes
+
+    fast, general = geometric.principal_frame(np.diag(moments)), principal_axes(moments)
+    np.testing.assert_array_equal(fast[0], general[0])
+    np.testing.assert_array_equal(fast[1], general[1])
+    assert np.linalg.det(fast[1]) == 1.0

@@ -95,9 +95,23 @@ class FlowNotConverged(ArithmeticError):
     """An implicit flow's Newton iteration did not converge in :data:`NEWTON_MAX` steps."""
 
 
+_EVEN = {(0, 1, 2), (1, 2, 0), (2, 0, 1)}
+
+
 def principal_frame(inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(moments, P)``: principal moments (ascending) and the proper rotation ``P`` whose
-    columns are the principal axes in body coordinates, ``I = P diag(moments) Pᵀ``."""
+    columns are the principal axes in body coordinates, ``I = P diag(moments) Pᵀ``.
+
+    ``inertia`` is a :class:`~tumble.rigid.RigidBody`'s (checked already); a diagonal one takes
+    a fast path that gives what :func:`tumble._elliptic.principal_axes` gives.
+    """
+    if inertia[0, 1] == inertia[0, 2] == inertia[1, 2] == 0.0:
+        moments = np.diagonal(inertia)
+        order = tuple(int(k) for k in np.argsort(moments, kind="stable"))
+        axes = np.eye(3)[:, order]
+        if order not in _EVEN:
+            axes[:, 0] = -axes[:, 0]
+        return moments[list(order)], axes
     return principal_axes(inertia)
 
 

@@ -114,10 +114,11 @@ class SplitStepper(BodyStepper):
     iteration fails leaves a NaN state, and :meth:`failure` says why.
     """
 
-    def __init__(self, method: Method, dynamics: Dynamics):
+    def __init__(self, method: Method, dynamics: Dynamics, frame=None):
         assert method.flow is not None
         self.method, self.dynamics = method, dynamics
-        self.moments, self.axes = geometric.principal_frame(dynamics.body.inertia)
+        frame = geometric.principal_frame(dynamics.body.inertia) if frame is None else frame
+        self.moments, self.axes = frame  # (moments, axes)
         self.flow = geometric.FLOWS[method.flow]
         self.unconverged = False
 
@@ -201,7 +202,7 @@ class CompiledSplitStepper(SplitStepper):
     def __init__(self, method: Method, dynamics: Dynamics, problem):
         from tumble.rigid.kernels import COMPILED_FLOWS
 
-        super().__init__(method, dynamics)
+        super().__init__(method, dynamics, (problem.moments, problem.axes))
         assert method.flow is not None
         self.problem, self.loop = problem, COMPILED_FLOWS[method.flow].loop
 
