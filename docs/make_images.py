@@ -80,6 +80,26 @@ def screenshot(page: Path, name: str) -> Path:
     return shrink(source, name)
 
 
+def long_run_energy() -> Path:
+    """docs/geometric.md's picture: P1, h = 0.05, 10⁶ steps, the largest energy error so far."""
+    import numpy as np
+
+    from tumble import RigidBody, simulate
+    from tumble.viz import rigid
+
+    body = RigidBody(1.0, [2.0, 1.0, 2.0 / 3.0], allow_unphysical=True)
+    L0 = (np.cos(1.1), 0.0, np.sin(1.1))
+    methods = ["split-axes", "split-axes4", "midpoint-lp", "dmv", "rkmk4", "rk4-quat"]
+    runs = [
+        (method, simulate(body, 50_000.0, method=method, h=0.05, L0=L0, record_every=100))
+        for method in methods
+    ]
+    source = Path(tempfile.mkdtemp()) / "long_run_energy.png"
+    title = "Hairer's body P1, h = 0.05, 10⁶ steps: the energy error"
+    rigid.energy_error_loglog(runs, source, title=title)
+    return shrink(source, "long_run_energy.png")
+
+
 def main() -> None:
     IMAGES.mkdir(exist_ok=True)
     work = Path(tempfile.mkdtemp())
@@ -111,6 +131,10 @@ def main() -> None:
     shrink(cantilever / "energy_midpoint.png", "energy.png")
     stability = folder("stability", beam.stability())
     shrink(stability / "stability_sweep.png", "stability_sweep.png")
+
+    long_run_energy()
+    top = folder("spinning-top", scenarios.get("spinning-top").run(), animation=False)
+    shrink(top / "top.png", "top.png")
 
 
 if __name__ == "__main__":
