@@ -392,7 +392,7 @@ def _solve3(j00, j01, j02, j10, j11, j12, j20, j21, j22, r0, r1, r2):
     return x0, x1, x2
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def _times_matrix(Rp, c00, c01, c02, c10, c11, c12, c20, c21, c22):
     """``R_p ← R_p C`` in place, row by row."""
     for r in range(3):
@@ -402,19 +402,27 @@ def _times_matrix(Rp, c00, c01, c02, c10, c11, c12, c20, c21, c22):
         Rp[r, 2] = a * c02 + b * c12 + c * c22
 
 
-@njit(**_JIT)
-def _turn(Rp, m0, m1, m2, axis, angle):
-    """``R_p ← R_p exp(angle ê_axis)`` in place; returns ``exp(−angle ê_axis) m``."""
-    c, s = math.cos(angle), math.sin(angle)
-    j, k = (axis + 1) % 3, (axis + 2) % 3
+@njit(**_INLINE)
+def _turn_columns(Rp, j, k, c, s):
+    """Columns ``j, k`` of ``R_p`` turned: ``(c R_j + s R_k, c R_k − s R_j)``."""
     for r in range(3):
         a, b = Rp[r, j], Rp[r, k]
         Rp[r, j] = c * a + s * b
         Rp[r, k] = c * b - s * a
+
+
+@njit(**_INLINE)
+def _turn(Rp, m0, m1, m2, axis, angle):
+    """``R_p ← R_p exp(angle ê_axis)`` in place; returns ``exp(−angle ê_axis) m``. ``axis`` is
+    a constant at each call, so after inlining every index below is one too."""
+    c, s = math.cos(angle), math.sin(angle)
     if axis == 0:
+        _turn_columns(Rp, 1, 2, c, s)
         return m0, c * m1 + s * m2, c * m2 - s * m1
     if axis == 1:
+        _turn_columns(Rp, 2, 0, c, s)
         return c * m0 - s * m2, m1, c * m2 + s * m0
+    _turn_columns(Rp, 0, 1, c, s)
     return c * m0 + s * m1, c * m1 - s * m0, m2
 
 
@@ -775,7 +783,7 @@ def _exact_flow(Rp, L0, L1, L2, moments, h, work):
     return True
 
 
-@njit(**_JIT)
+@njit(**_INLINE)
 def _kick(problem, z, Rp, s):
     """``(p, L) += s (F, τ)`` at the state ``(z, R_p)``; body vectors ``r`` are turned by
     ``R r = R_p (Pᵀ r)``."""
@@ -822,6 +830,9 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
     t_a, t_b, h, n = grid
     weights, mass = problem.b, problem.m
     saved, R_saved, work = np.empty(9), np.empty((3, 3)), np.empty(WORK_SIZE)
+    loaded = problem.points.shape[0] > 0
+    for c in range(3):
+        loaded = loaded or problem.F[c] != 0.0 or problem.tau[c] != 0.0
     count, until_record = 0, every - (step0 + k0) % every
     for k in range(k0 + 1, k1 + 1):
         t_old = t_a + (k - 1) * h
@@ -831,11 +842,13 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
         converged = True
         for w in weights:
             s = w * hk
-            _kick(problem, z, Rn, 0.5 * s)
+            if loaded:
+                _kick(problem, z, Rn, 0.5 * s)
             for c in range(3):
                 z[c] += s * z[3 + c] / mass
             converged = FLOW(Rn, z[6], z[7], z[8], problem.moments, s, work) and converged  # noqa: F821
-            _kick(problem, z, Rn, 0.5 * s)
+            if loaded:
+                _kick(problem, z, Rn, 0.5 * s)
         finite = True
         for q in range(9):
             finite = finite and math.isfinite(z[q])
