@@ -449,11 +449,11 @@ def simulate_batch(
     loads = _kernel_loads(forces, bodies)
     settings = {"h": h, "rtol": None, "atol": None, "record_every": every, "compiled": True}
     batch = _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings)
-    with np.errstate(over="ignore", invalid="ignore"):
-        batch.potential_energy = np.array([
-            potential_energy(split_loads(forces)[0], batch.x[k], batch.R[k], body.mass)
-            for k, body in enumerate(batch.bodies)
-        ]).reshape(batch.x.shape[:2])  # fmt: skip
+    conservative = [load for load in split_loads(forces)[0] if load.conservative]
+    if conservative:  # V for every body and sample at once (mass broadcast over time)
+        masses = _per_body(batch.bodies, lambda body: body.mass)[:, None]
+        with np.errstate(over="ignore", invalid="ignore"):
+            batch.potential_energy = potential_energy(conservative, batch.x, batch.R, masses)
     return batch
 
 
@@ -533,9 +533,13 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
     """Run the kernel for every body; lay the samples out as (body, time, …) arrays."""
     mass = _per_body(bodies, lambda body: body.mass)
     inv_I = _per_body(bodies, lambda body: body.inertia_inverse)
-    frames = [geometric.principal_frame(body.inertia) for body in bodies]
-    moments = np.array([frame[0] for frame in frames])
-    axes = np.array([frame[1] for frame in frames])
+    if spec.family == "split":  # each distinct body's principal frame, once
+        moments = _per_body(bodies, lambda body: geometric.principal_frame(body.inertia)[0])
+        axes = _per_body(bodies, lambda body: geometric.principal_frame(body.inertia)[1])
+    else:  # unused by the other loops: placeholders of the same (read-only) array type
+        moments, axes = np.ones((len(bodies), 3)), np.tile(np.eye(3), (len(bodies), 1, 1))
+        moments.setflags(write=False)
+        axes.setflags(write=False)
     stepper = BatchStepper(spec, problem(spec, inv_I, mass, loads, axes, moments))
     out = march(stepper, (t0, t_end), stepper.start((R, Y)), h=h, record_every=every)
     names = ("R", "Y", "q") if spec.family == "quat" else ("R", "Y")

@@ -264,9 +264,10 @@ def total_load(loads, t: float, state: State, mass: float) -> tuple[np.ndarray, 
 
 
 def potential_energy(loads, x: np.ndarray, R: np.ndarray, mass: float) -> np.ndarray:
-    """``V`` of the loads that have a potential, summed, at samples ``x`` (n, 3), ``R``
-    (n, 3, 3); shape (n,), J. Loads without one (:class:`Torque`, callables) add nothing."""
-    V = np.zeros(len(x))
+    """``V`` of the loads that have a potential, summed, at samples ``x`` (..., 3), ``R``
+    (..., 3, 3); shape (...), J. Loads without one (:class:`Torque`, callables) add nothing.
+    ``mass`` may be an array that broadcasts against the leading axes (a batch's bodies)."""
+    V = np.zeros(np.shape(x)[:-1])
     for load in loads:
         if load.conservative:
             V = V + load.potential(x, R, mass)
