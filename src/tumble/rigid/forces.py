@@ -263,7 +263,7 @@ def total_load(loads, t: float, state: State, mass: float) -> tuple[np.ndarray, 
     return F, tau
 
 
-def potential_energy(loads, x: np.ndarray, R: np.ndarray, mass: float) -> np.ndarray:
+def potential_energy(loads, x: np.ndarray, R: np.ndarray, mass: float | np.ndarray) -> np.ndarray:
     """``V`` of the loads that have a potential, summed, at samples ``x`` (..., 3), ``R``
     (..., 3, 3); shape (...), J. Loads without one (:class:`Torque`, callables) add nothing.
     ``mass`` may be an array that broadcasts against the leading axes (a batch's bodies)."""
