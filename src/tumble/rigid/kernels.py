@@ -427,19 +427,24 @@ def _turn(Rp, m0, m1, m2, axis, angle):
 
 
 @njit(**_INLINE)
-def _axes_flow(Rp, L0, L1, L2, moments, h, work):
-    """Strang's splitting by axes, ``1, 2, 3, 2, 1`` (each rotation exact)."""
+def _axes_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
+    """Strang's splitting by axes, ``1, 2, 3, 2, 1`` (each rotation exact). The outer turns
+    about axis 1 go by ``head/2`` and ``tail/2`` instead of ``h/2`` (0: left out): axis 1's
+    turn leaves ``m₁`` alone, so the last turn of a step and the first of the next are one
+    turn by their sum, which the loop takes when nothing happens between them."""
     m0, m1, m2 = _apply_transpose(Rp, L0, L1, L2)
-    m0, m1, m2 = _turn(Rp, m0, m1, m2, 0, 0.5 * h * m0 / moments[0])
+    if head != 0.0:
+        m0, m1, m2 = _turn(Rp, m0, m1, m2, 0, 0.5 * head * m0 / moments[0])
     m0, m1, m2 = _turn(Rp, m0, m1, m2, 1, 0.5 * h * m1 / moments[1])
     m0, m1, m2 = _turn(Rp, m0, m1, m2, 2, h * m2 / moments[2])
     m0, m1, m2 = _turn(Rp, m0, m1, m2, 1, 0.5 * h * m1 / moments[1])
-    _turn(Rp, m0, m1, m2, 0, 0.5 * h * m0 / moments[0])
+    if tail != 0.0:
+        _turn(Rp, m0, m1, m2, 0, 0.5 * tail * m0 / moments[0])
     return True
 
 
 @njit(**_INLINE)
-def _midpoint_flow(Rp, L0, L1, L2, moments, h, work):
+def _midpoint_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
     """Implicit midpoint on ``ṁ = m × I⁻¹m`` by Newton, then ``R_p ← R_p cay(h I⁻¹m̄)``."""
     m0, m1, m2 = _apply_transpose(Rp, L0, L1, L2)
     i0, i1, i2 = 1.0 / moments[0], 1.0 / moments[1], 1.0 / moments[2]
@@ -475,7 +480,7 @@ def _midpoint_flow(Rp, L0, L1, L2, moments, h, work):
 
 
 @njit(**_INLINE)
-def _dmv_flow(Rp, L0, L1, L2, moments, h, work):
+def _dmv_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
     """Moser–Veselov: Newton on ``h m = 2 e₀ I e + 2 (D e) × e`` for Ω's quaternion."""
     m0, m1, m2 = _apply_transpose(Rp, L0, L1, L2)
     I0, I1, I2 = moments[0], moments[1], moments[2]
@@ -673,7 +678,7 @@ def _orthonormalise(Rp):
 
 
 @njit(**_INLINE)
-def _exact_flow(Rp, L0, L1, L2, moments, h, work):
+def _exact_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
     """The exact free-body flow over ``h`` (``tumble.rigid.geometric.exact_flow``)."""
     A, B, C = moments[0], moments[1], moments[2]
     m0, m1, m2 = _apply_transpose(Rp, L0, L1, L2)
@@ -833,20 +838,29 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
     loaded = problem.points.shape[0] > 0
     for c in range(3):
         loaded = loaded or problem.F[c] != 0.0 or problem.tau[c] != 0.0
+    merge = MERGES and not loaded  # noqa: F821
+    owed = 0.0  # a sub-step whose last half turn about axis 1 is still to do (merged)
+    last = weights.shape[0] - 1
     count, until_record = 0, every - (step0 + k0) % every
     for k in range(k0 + 1, k1 + 1):
         t_old = t_a + (k - 1) * h
         hk = (t_b if k == n else t_a + k * h) - t_old
         saved[:] = z
         R_saved[:, :] = Rn
+        owed_before = owed
+        settle = until_record == 1 or k == k1  # this step's end is recorded or handed back
         converged = True
-        for w in weights:
-            s = w * hk
+        for index in range(last + 1):
+            s = weights[index] * hk
             if loaded:
                 _kick(problem, z, Rn, 0.5 * s)
             for c in range(3):
                 z[c] += s * z[3 + c] / mass
-            converged = FLOW(Rn, z[6], z[7], z[8], problem.moments, s, work) and converged  # noqa: F821
+            head, tail = owed + s, s
+            owed = 0.0
+            if merge and not (settle and index == last):
+                tail, owed = 0.0, s
+            converged = FLOW(Rn, z[6], z[7], z[8], problem.moments, s, work, head, tail) and converged  # noqa: F821
             if loaded:
                 _kick(problem, z, Rn, 0.5 * s)
         finite = True
@@ -858,6 +872,8 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
         if not (finite and converged):
             z[:] = saved
             Rn[:, :] = R_saved
+            if owed_before != 0.0:  # the state before: finish its last half turn
+                FLOW(Rn, z[6], z[7], z[8], problem.moments, 0.0, work, 0.0, owed_before)  # noqa: F821
             return count, k, NON_FINITE if not finite else UNCONVERGED
         until_record -= 1
         if until_record == 0:
@@ -869,7 +885,8 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
 
 
 def _for_flow(name: str, flow) -> CompiledChart:
-    loop = njit(**_JIT)(_bind(_split_loop, f"_split_loop_{name}", FLOW=flow))
+    merges = name == "axes"  # the only flow with separable outer turns
+    loop = njit(**_JIT)(_bind(_split_loop, f"_split_loop_{name}", FLOW=flow, MERGES=merges))
     batch = njit(parallel=True, **_JIT)(_bind(_batch, f"_batch_split_{name}", LOOP=loop))
     return CompiledChart(loop, batch)
 
