@@ -860,7 +860,8 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
             owed = 0.0
             if merge and not (settle and index == last):
                 tail, owed = 0.0, s
-            converged = FLOW(Rn, z[6], z[7], z[8], problem.moments, s, work, head, tail) and converged  # noqa: F821
+            step_ok = FLOW(Rn, z[6], z[7], z[8], problem.moments, s, work, head, tail)  # noqa: F821
+            converged = converged and step_ok
             if loaded:
                 _kick(problem, z, Rn, 0.5 * s)
         finite = True
