@@ -149,3 +149,20 @@ def test_a_figure_that_fails_to_draw_leaves_no_file(tmp_path):
     with pytest.raises(ValueError):
         save(fig, tmp_path / "plot.nosuchformat")
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("umask", [0o022, 0o077, 0o002])
+def test_atomic_write_gives_the_mode_an_ordinary_write_gives(tmp_path, umask):
+    # Issue 18: run-folder files came out 0600 (mkstemp's mode) whatever the umask.
+    import os
+    import stat
+
+    previous = os.umask(umask)
+    try:
+        atomic_write(tmp_path / "view.html", lambda tmp: tmp.write_text("<html></html>"))
+        with open(tmp_path / "plain.txt", "w") as handle:
+            handle.write("x")
+    finally:
+        os.umask(previous)
+    mode = stat.S_IMODE((tmp_path / "view.html").stat().st_mode)
+    assert mode == stat.S_IMODE((tmp_path / "plain.txt").stat().st_mode) == 0o666 & ~umask

@@ -17,6 +17,10 @@ def atomic_write(path: str | PathLike[str], writer: Callable[[Path], object]) ->
     matplotlib read the format from it — and is removed if ``writer`` raises. ``os.replace``
     is atomic on POSIX: readers see the old file or the new one, never half of one.
 
+    The file gets the mode an ordinary ``open(path, "w")`` would give it, ``0o666`` less the
+    process umask (``mkstemp`` makes its temporary ``0o600``, which would keep colleagues and
+    web servers from reading a run folder).
+
     Returns
     -------
     Path
@@ -30,7 +34,15 @@ def atomic_write(path: str | PathLike[str], writer: Callable[[Path], object]) ->
     tmp = Path(name)
     try:
         writer(tmp)
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)
     return path
+
+
+def _umask() -> int:
+    """The process umask (read by setting it and setting it back: POSIX has no getter)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
