@@ -154,6 +154,23 @@ def test_rk4_matrix_drifts_off_so3_where_rkmk4_does_not(hairer):
     assert lie.orthogonality_error.max() < 1e-12
 
 
-def test_rk4_quat_keeps_unit_norm(hairer):
-    run = simulate(hairer, 10.0, method="rk4-quat", h=0.1, L0=L0)
-    assert np.abs(run.quaternion_norm_error).max() < 1e-15
+@pytest.mark.parametrize("compiled", [False, True])
+def test_quaternion_norm_error_is_what_the_renormalisation_removes(hairer, compiled):
+    # Issue 18: |q| − 1 was recorded after q ← q/|q| and always read 1e-16. It is now the
+    # step's own departure: one RK4 step from a unit q, by hand, gives the first one.
+    run = simulate(hairer, 10.0, method="rk4-quat", h=0.1, L0=L0, compiled=compiled)
+    from tumble import so3
+    from tumble.ode.stepper import rk_step
+    from tumble.ode.tableaux import RK4
+
+    def f(t, q):
+        omega = (so3.matrix_from_quat(q).T @ L0) / INERTIA
+        return 0.5 * so3.quat_mul(q, np.concatenate([[0.0], omega]))
+
+    q0 = np.array([1.0, 0.0, 0.0, 0.0])
+    q1, _ = rk_step(f, 0.0, q0, f(0.0, q0), 0.1, RK4, np.empty((4, 4)))
+    assert run.quaternion_norm_error[0] == 0.0
+    assert run.quaternion_norm_error[1] == pytest.approx(np.linalg.norm(q1) - 1, rel=1e-9)
+    assert 1e-9 < np.abs(run.quaternion_norm_error[1:]).max() < 1e-5
+    np.testing.assert_allclose(np.linalg.norm(run.q, axis=1), 1.0, atol=1e-15)
+    assert run.orthogonality_error.max() < 1e-14

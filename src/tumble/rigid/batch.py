@@ -140,7 +140,8 @@ class BatchTrajectory:
     def q(self) -> np.ndarray:
         """Unit quaternions ``[w, x, y, z]`` with ``w ≥ 0``, shape (N, n, 4)."""
         if self.q_raw is not None:
-            q = self.q_raw
+            with np.errstate(invalid="ignore", over="ignore"):
+                q = self.q_raw / np.linalg.norm(self.q_raw, axis=-1, keepdims=True)
         else:
             with np.errstate(invalid="ignore"):
                 U, _, Vt = np.linalg.svd(np.nan_to_num(self.R))  # nearest rotation

@@ -9,7 +9,8 @@ For the duration of one step a chart turns the rigid body into an ODE on a vecto
 chart      ``z``                     vector field                map back
 =========  ========================  ==========================  ============================
 matrix     ``(vec R, x, p, L)``      ``Ṙ = R ω̂``                 ``R`` (leaves SO(3))
-quat       ``(q, x, p, L)``          ``q̇ = ½ q ⊗ (0, ω)``        ``q ← q/|q|``
+quat       ``(q, x, p, L)``          ``q̇ = ½ q ⊗ (0, ω)``        ``q`` (normalised at the next
+                                                                step's start)
 lie        ``(u, x, p, L)``, u(0)=0  ``u̇ = dexp⁻¹_{−u}(ω)``      ``R ← R_n exp(û)``
 =========  ========================  ==========================  ============================
 
@@ -146,13 +147,18 @@ MATRIX = Chart(
     read=lambda z, Rn: (z[..., :9].reshape((*z.shape[:-1], 3, 3)).copy(), z[..., 9:].copy()),
     field=_matrix_field,
 )
+# quat: the step starts from q/|q| and ends with q as the tableau left it, so the record
+# keeps |q| − 1 before normalising (matrix_from_quat normalises).
 QUAT = Chart(
     name="quat",
     size=4,
     attitude=so3.quat_from_matrix,
     matrix=so3.matrix_from_quat,
-    pack=lambda q, Y: (np.concatenate([q, Y], axis=-1), _frames(np.shape(q)[:-1])),
-    advance=lambda z, Rn: (z[:4] / np.linalg.norm(z[:4]), z[4:].copy()),
+    pack=lambda q, Y: (
+        np.concatenate([q / np.linalg.norm(q, axis=-1, keepdims=True), Y], axis=-1),
+        _frames(np.shape(q)[:-1]),
+    ),
+    advance=lambda z, Rn: (z[:4].copy(), z[4:].copy()),
     read=lambda z, Rn: (z[..., :4].copy(), z[..., 4:].copy()),
     field=_quat_field,
 )

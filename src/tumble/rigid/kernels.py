@@ -190,20 +190,33 @@ def _quat_field(problem, zs, Rn, R, K, i):
 
 
 @njit(**_INLINE)
-def _quat_advance(z, znew, Rn):
-    """``q ← q/|q|``."""
-    norm = math.sqrt(znew[0] ** 2 + znew[1] ** 2 + znew[2] ** 2 + znew[3] ** 2)
+def _quat_start(z, Rn):
+    """``q ← q/|q|`` at the start of a step: the step ends with the quaternion as the
+    tableau left it, so that the record sees ``|q| − 1`` before it is removed."""
+    norm = math.sqrt(z[0] ** 2 + z[1] ** 2 + z[2] ** 2 + z[3] ** 2)
     for q in range(4):
-        z[q] = znew[q] / norm
-    for q in range(4, z.shape[0]):
+        z[q] = z[q] / norm
+
+
+@njit(**_INLINE)
+def _quat_advance(z, znew, Rn):
+    """The step's result, ``q`` not yet normalised (:func:`_quat_start` does that)."""
+    for q in range(z.shape[0]):
         z[q] = znew[q]
 
 
 @njit(**_JIT)
 def _quat_record(z, Rn, R_out, q_out, Y_out):
-    _quat_matrix(z[0], z[1], z[2], z[3], R_out)
+    """R of ``q/|q|``; ``q`` as it is (its norm error is the step's)."""
+    norm = math.sqrt(z[0] ** 2 + z[1] ** 2 + z[2] ** 2 + z[3] ** 2)
+    _quat_matrix(z[0] / norm, z[1] / norm, z[2] / norm, z[3] / norm, R_out)
     q_out[:] = z[:4]
     Y_out[:] = z[4:]
+
+
+@njit(**_INLINE)
+def _no_start(z, Rn):
+    """Charts that need nothing at the start of a step."""
 
 
 @njit(**_INLINE)
@@ -279,7 +292,8 @@ def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
     .. math:: k_i = f\\Bigl(z + h \\sum_{j<i} a_{ij} k_j\\Bigr), \\quad
               z_{n+1} = z + h \\sum_i b_i k_i,
 
-    then the chart's map back. ``z`` (and ``Rn``) hold the state and are updated in place.
+    then the chart's map back (``START`` runs before each step: the ``quat`` chart normalises
+    there). ``z`` (and ``Rn``) hold the state and are updated in place.
     Step ``k`` is recorded when ``step0 + k`` is a multiple of ``every``. Returns
     ``(recorded, failed, cause)``: ``failed`` is the step whose result was not finite (the
     state is left at the step before), or -1; ``cause`` is :data:`NON_FINITE` then.
@@ -294,6 +308,7 @@ def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
     for k in range(k0 + 1, k1 + 1):
         t_old = t_a + (k - 1) * h
         hk = (t_b if k == n else t_a + k * h) - t_old
+        START(z, Rn)  # noqa: F821
         for i in range(s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
             for q in range(nz):
                 acc = 0.0
@@ -357,15 +372,17 @@ class CompiledChart:
     batch: Callable[..., None]
 
 
-def _for_chart(name: str, field, advance, record) -> CompiledChart:
-    loop = njit(**_JIT)(_bind(_loop, f"_loop_{name}", FIELD=field, ADVANCE=advance, RECORD=record))
+def _for_chart(name: str, field, advance, record, start=_no_start) -> CompiledChart:
+    loop = njit(**_JIT)(
+        _bind(_loop, f"_loop_{name}", FIELD=field, ADVANCE=advance, RECORD=record, START=start)
+    )
     batch = njit(parallel=True, **_JIT)(_bind(_batch, f"_batch_{name}", LOOP=loop))
     return CompiledChart(loop, batch)
 
 
 COMPILED: dict[str, CompiledChart] = {
     "matrix": _for_chart("matrix", _matrix_field, _matrix_advance, _matrix_record),
-    "quat": _for_chart("quat", _quat_field, _quat_advance, _quat_record),
+    "quat": _for_chart("quat", _quat_field, _quat_advance, _quat_record, _quat_start),
     "lie": _for_chart("lie", _lie_field, _lie_advance, _lie_record),
 }
 """Each chart of :data:`tumble.rigid.charts.CHARTS`, compiled."""

@@ -42,7 +42,8 @@ class Trajectory:
     t_events : list of ndarray
         For each event, the times at which it fired.
     q_raw : ndarray, shape (n, 4), optional
-        The quaternions the ``quat`` method carried (otherwise ``q`` comes from ``R``).
+        The quaternions the ``quat`` method carried, as each step left them (before the
+        renormalisation the next step starts with); otherwise ``q`` comes from ``R``.
     potential_energy : ndarray, shape (n,), optional
         ``V`` of the loads that derive from a potential (gravity, constant forces, magnetic
         dipoles), J; zeros without such loads (``None`` given: zeros).
@@ -87,7 +88,8 @@ class Trajectory:
     def q(self) -> np.ndarray:
         """Unit quaternions ``[w, x, y, z]``, shape (n, 4), with ``w ≥ 0``."""
         if self.q_raw is not None:
-            q = self.q_raw
+            with np.errstate(invalid="ignore", over="ignore"):
+                q = self.q_raw / np.linalg.norm(self.q_raw, axis=1, keepdims=True)
         else:
             U, _, Vt = np.linalg.svd(self.R)  # nearest rotation, for matrices off SO(3)
             q = so3.quat_from_matrix(U @ Vt)
@@ -169,7 +171,9 @@ class Trajectory:
 
     @cached_property
     def quaternion_norm_error(self) -> np.ndarray:
-        """``|q| − 1`` of the carried quaternions (zeros for the other families), shape (n,)."""
+        """``|q| − 1`` of the carried quaternions before each renormalisation (zeros for the
+        other families), shape (n,): what the ``quat`` methods' ``q ← q/|q|`` removes, the
+        step's departure from the unit sphere (the first sample is the initial unit q)."""
         if self.q_raw is None:
             return np.zeros(len(self.t))
         return np.linalg.norm(self.q_raw, axis=1) - 1.0
