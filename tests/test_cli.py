@@ -238,3 +238,30 @@ def test_a_value_refused_by_the_scenario_names_the_file(tmp_path):
     result = runner.invoke(app, ["run", str(path), "--out", str(tmp_path / "o")])
     assert result.exit_code == 2
     assert "fat.toml" in result.output and "minor_radius" in result.output
+
+
+def test_a_run_that_stops_early_exits_3_and_says_why_without_warnings(tmp_path):
+    # Issue 18: omega0 = [1e300, 0, 0] overflowed in the first step; the CLI exited 0 with
+    # numpy's RuntimeWarnings on the terminal. It writes the folder, says which run stopped,
+    # when and why, and exits 3.
+    toml = tmp_path / "spin.toml"
+    toml.write_text(
+        'scenario = "torus-spin"\n[options]\nt_end = 2.0\nomega0 = [1e300, 0.0, 0.0]\n'
+        'methods = ["rkmk4"]\n[outputs]\nanimation = false\n'
+    )
+    result = runner.invoke(app, ["run", str(toml), "--out", str(tmp_path / "out")])
+    assert result.exit_code == 3, result.output
+    assert "trajectories.rkmk4 did not reach its end" in result.output
+    assert "non-finite" in result.output and "t=0.0" in result.output
+    assert "Warning" not in result.output
+    assert (tmp_path / "out" / "summary.json").exists()
+
+
+def test_a_scenario_whose_stops_are_the_point_exits_0(tmp_path):
+    # The beam shows the conditionally stable schemes diverging past their step limit.
+    out = tmp_path / "beam"
+    options = ["--out", str(out), "--no-animation"]
+    result = runner.invoke(app, ["run", "beam", *options])
+    assert result.exit_code == 0, result.output
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["schemes"]["explicit"]["status"] == -1

@@ -1,7 +1,10 @@
 """The ``tumble`` command: parse, call the library, report. Nothing else lives here.
 
 Every command exits with 0 on success and 2 on bad input, printing a message that names the
-option or key, the bad value and what is allowed (the library's ``ValueError``).
+option or key, the bad value and what is allowed (the library's ``ValueError``). ``tumble run``
+exits with 3 when a run of the scenario stopped before its end (a state that stopped being
+finite, an implicit solve that did not converge): the run folder is written, and the message
+says which run stopped, when and why. Numerical warnings of the library stay off the terminal.
 """
 
 from __future__ import annotations
@@ -74,6 +77,9 @@ def _write(result: ScenarioResult, out: Path, force: bool, animation: bool, note
         result, out, force=force, animation=animation, on_file=lambda name: note(f"writing {name}")
     )
 
+
+UNFINISHED = 3
+"""``tumble run``'s exit code when a run of the scenario stopped before its end."""
 
 MAX_ROWS = 40
 """The printed summary stops after this many numbers (summary.json has them all)."""
@@ -173,12 +179,19 @@ def run(
             )
         options = _apply(name, options, method=method, h=h, t_end=t_end)
         options = files.check_options(name, options)
-        with _progress(f"running {name}") as note:
+        with _progress(f"running {name}") as note, warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # overflow, nan: said in words below
             result = _run_scenario(name, options, None if target == name else target)
             folder = _write(
                 result, out or Path("runs") / default, force, animation and file_animation, note
             )
     _show_summary(name, result.summary, folder)
+    stopped = result.unfinished()
+    if stopped:
+        for where, message in stopped:
+            errors.print(f"error: {where} did not reach its end:", style="bold red", end=" ")
+            errors.print(message, markup=False, highlight=False, soft_wrap=True)
+        raise typer.Exit(code=UNFINISHED)
 
 
 def _run_scenario(name: str, options: dict, source: str | None) -> ScenarioResult:

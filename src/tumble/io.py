@@ -70,6 +70,10 @@ class ScenarioResult:
         root attributes of ``data.nc``; numbers, strings and lists of numbers only.
     animations : list of (str, callable)
         Like ``figures``, for the slower outputs (``animation.gif``, ``view.html``).
+    expected_stops : tuple of str
+        Runs in ``data`` (as :meth:`unfinished` names them) whose stop is what the scenario
+        shows, such as a conditionally stable scheme past its step limit: not reported as
+        unfinished.
     """
 
     name: str
@@ -79,6 +83,42 @@ class ScenarioResult:
     datasets: dict[str, Any] = field(default_factory=dict)
     attrs: dict[str, Any] = field(default_factory=dict)
     animations: list[tuple[str, FigureWriter]] = field(default_factory=list)
+    expected_stops: tuple[str, ...] = ()
+
+    def unfinished(self) -> list[tuple[str, str]]:
+        """The runs in :attr:`data` that stopped before their end: ``(where, message)`` for
+        every result whose ``status`` (a :class:`~tumble.ode.Status`, or one per body of a
+        batch) is negative, found through nested dicts, lists and tuples, less
+        :attr:`expected_stops`.
+
+        Examples
+        --------
+        >>> from tumble.ode.driver import Status
+        >>> class Run:
+        ...     status, message = Status.FAILED, "the state became non-finite at t=0.3"
+        >>> ScenarioResult("demo", {}, data={"trajectories": {"rkmk4": Run()}}).unfinished()
+        [('trajectories.rkmk4', 'the state became non-finite at t=0.3')]
+        """
+        found: list[tuple[str, str]] = []
+        _collect_unfinished(self.data, "", found)
+        return [(where, message) for where, message in found if where not in self.expected_stops]
+
+
+def _collect_unfinished(value: Any, where: str, found: list, depth: int = 0) -> None:
+    if depth > 4:
+        return
+    if isinstance(value, dict):
+        for key, item in value.items():
+            _collect_unfinished(item, f"{where}.{key}" if where else str(key), found, depth + 1)
+    elif isinstance(value, list | tuple):
+        for index, item in enumerate(value):
+            _collect_unfinished(item, f"{where}[{index}]", found, depth + 1)
+    elif hasattr(value, "status"):
+        status = np.atleast_1d(np.asarray(value.status))
+        messages = getattr(value, "messages", None) or [getattr(value, "message", "")]
+        for stopped in np.flatnonzero(status < 0).tolist():
+            label = f"{where}[{stopped}]" if status.size > 1 else where
+            found.append((label, str(messages[min(stopped, len(messages) - 1)])))
 
 
 def _finite(value: Any) -> Any:
