@@ -44,6 +44,11 @@ REFUSALS = [
     ("values", lambda: _checks.values("step_sizes", [[0.1, 0.2]]), "step_sizes", [[0.1, 0.2]]),
     ("values", lambda: _checks.values("errors", [1e-3, 0.0], positive=True), "errors[1]", 0.0),
     ("values", lambda: _checks.values("dts", [1e-3, INF], positive=True), "dts[1]", INF),
+    ("flag", lambda: _checks.flag("progress", "yes"), "progress", "yes"),
+    ("flag", lambda: _checks.flag("dense_output", 1), "dense_output", 1),
+    ("callables", lambda: _checks.callables("events", 42), "events", 42),
+    ("callables", lambda: _checks.callables("events", "g"), "events", "g"),
+    ("callables", lambda: _checks.callables("events", [print, 3]), "events[1]", 3),
 ]
 
 

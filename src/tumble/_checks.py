@@ -184,3 +184,37 @@ def values(
         index = int(np.argmin(good))
         raise fail(f"{name}[{index}]", float(result[index]), each, unit, remedy)
     return result
+
+
+def flag(name: str, value: object) -> bool:
+    """``value`` if it is a boolean (``True``/``False``, numpy's too), else the ValueError:
+    a string such as ``"yes"`` or ``"false"`` is refused, not read as true.
+
+    Examples
+    --------
+    >>> flag("progress", False)
+    False
+    >>> flag("progress", "x")
+    Traceback (most recent call last):
+    ...
+    ValueError: progress='x' is not allowed: must be True or False
+    """
+    if isinstance(value, bool | np.bool_):
+        return bool(value)
+    raise fail(name, value, "True or False")
+
+
+def callables(name: str, value: object, remedy: str = "") -> list:
+    """``value`` as a list of callables: one callable, or a sequence of them; None is
+    ``[]``. Anything else is refused naming ``name`` (or ``name[i]`` for a bad item)."""
+    if value is None:
+        return []
+    if callable(value):
+        return [value]
+    if isinstance(value, str | bytes) or not isinstance(value, Iterable):
+        raise fail(name, value, "a callable g(t, y) or a sequence of them", remedy=remedy)
+    items = list(value)
+    for index, item in enumerate(items):
+        if not callable(item):
+            raise fail(f"{name}[{index}]", item, "a callable g(t, y)", remedy=remedy)
+    return items

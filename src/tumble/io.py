@@ -31,11 +31,13 @@ import json
 import logging
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
+from os import PathLike
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from tumble import _checks
 from tumble._atomic import atomic_write
 from tumble._version import __version__
 
@@ -305,6 +307,8 @@ def load(path: str | Path) -> Run:
     """
     import xarray as xr
 
+    if not isinstance(path, str | PathLike):
+        raise _checks.fail("path", path, "a run folder or its data.nc, as a str or Path")
     path = Path(path)
     folder = path.parent if path.name == DATA_FILE else path
     for name in (SUMMARY_FILE, DATA_FILE):

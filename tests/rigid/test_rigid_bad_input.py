@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tumble.rigid import RigidBody, simulate
+from tumble.rigid import Impulse, RigidBody, simulate
 
 BODY = RigidBody(1.0, [1.0, 2.0, 2.5])
 
@@ -84,3 +84,43 @@ def test_tolerance_for_fixed_step_method_is_refused():
 def test_unknown_load_is_refused():
     with pytest.raises(ValueError, match=r"forces\[0\]"):
         simulate(BODY, 1.0, h=0.1, forces=[(0, 0, -9.81)])
+
+
+# Issue 18 item 11: values that were accepted silently or answered with a bare TypeError.
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (dict(events=42), r"^events=42 is not allowed: must be a callable"),
+        (dict(events=[42]), r"^events\[0\]=42 is not allowed: must be a callable"),
+        (dict(progress="x"), r"^progress='x' is not allowed: must be True or False"),
+        (
+            dict(forces=[Impulse((0, 0, 0), (1, 0, 0), time=5.0)]),
+            r"^forces\[0\]\.time=5\.0 is not allowed: must be within the run, \[0\.0, 1\.0\]",
+        ),
+    ],
+    ids=["events-int", "events-item", "progress-str", "impulse-after-the-end"],
+)
+def test_silently_accepted_values_are_refused(options, message):
+    with pytest.raises(ValueError, match=message):
+        simulate(RigidBody(1.0, [1.0, 2.0, 3.0]), 1.0, h=0.1, **options)
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        (dict(events=42), r"^events=42 is not allowed"),
+        (dict(dense_output="yes"), r"^dense_output='yes' is not allowed: must be True or False"),
+    ],
+)
+def test_solve_refuses_the_same(options, message):
+    from tumble import solve
+
+    with pytest.raises(ValueError, match=message):
+        solve(lambda t, y: -y, (0.0, 1.0), [1.0], h=0.1, **options)
+
+
+def test_io_load_of_none_names_the_path():
+    from tumble import io
+
+    with pytest.raises(ValueError, match=r"^path=None is not allowed"):
+        io.load(None)

@@ -221,8 +221,8 @@ def solve(
     h = _check_step(h, tableau)
     atol_array = _check_tolerances(rtol, atol, y.size)
     max_steps = _checks.count("max_steps", max_steps)
-    if events is not None and callable(events):
-        events = [events]
+    events = _checks.callables("events", events)
+    dense_output = _checks.flag("dense_output", dense_output)
     counted = _CountedFunction(fun, y.size)
     stepper = RungeKutta(counted, tableau, t0, y)
     control = None

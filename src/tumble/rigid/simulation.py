@@ -67,6 +67,16 @@ def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> Prob
                    axes, moments)  # fmt: skip
 
 
+def _check_impulse_times(forces, t0: float, t_end: float) -> None:
+    """Every impulse within the run: one outside it would be silently ignored."""
+    for index, item in enumerate(forces):
+        if isinstance(item, Impulse) and not t0 <= item.time <= t_end:
+            raise _checks.fail(
+                f"forces[{index}].time", item.time, f"within the run, [{t0!r}, {t_end!r}]", "s",
+                remedy="an impulse outside the run would never be applied",
+            )  # fmt: skip
+
+
 def check_free(method: Method, loads) -> None:
     """The exact flow takes no continuous load: a ValueError pointing to the splittings."""
     if method.exact and loads:
@@ -207,9 +217,11 @@ def simulate(
     h, rtol, atol = initial.check_steps(spec, h, rtol, atol)
     R, Y = initial.initial_state(body, x0, v0, R0, q0, omega0, L0)
     record_every = _checks.count("record_every", record_every)
+    progress = _checks.flag("progress", progress)
     loads, impulses = split_loads(forces)
     check_free(spec, loads)
-    events = list(events)
+    _check_impulse_times(forces, t0, t_end)
+    events = _checks.callables("events", events, remedy="g(t, state) with state a State")
     kernel_loads = compiled_loads(loads, body.mass)
     use_kernel = not spec.adaptive and kernel_loads is not None and not events
     if compiled and not use_kernel:
