@@ -384,9 +384,7 @@ def test_from_mesh_refuses_inconsistent_winding():
 def test_from_mesh_refuses_an_unreadable_file(tmp_path):
     path = tmp_path / "broken.stl"
     path.write_bytes(b"not an stl file")
-    with pytest.raises(
-        ValueError, match=r"path=.*broken.* is not allowed: must be a mesh file with triangles"
-    ):
+    with pytest.raises(ValueError, match=r"path=.*broken.* is not allowed: must be an STL file"):
         meshes.from_mesh(path, density=1.0)
 
 

@@ -132,7 +132,7 @@ def test_load_refuses_an_unknown_extension(tmp_path):
 
 def test_load_refuses_a_file_without_triangles(tmp_path):
     path = tmp_path / "garbage.stl"
-    path.write_bytes(b"\x00garbage")
+    path.write_bytes(b"\x00" * 80 + (0).to_bytes(4, "little"))  # binary STL of 0 triangles
     with pytest.raises(
         ValueError, match=r"path=.*garbage.* is not allowed: must be a mesh file with triangles"
     ):
@@ -199,3 +199,25 @@ def test_save_refuses_a_non_mesh(tmp_path):
         ValueError, match=r"mesh='x' is not allowed: must be a trimesh.Trimesh with faces"
     ):
         meshes.save("x", tmp_path / "x.stl")
+
+
+def test_random_bytes_named_stl_are_refused_as_not_stl(tmp_path):
+    # Issue 18: random bytes named x.stl were refused with "No module named
+    # 'charset_normalizer'" (trimesh's text sniffing). Say what is wrong with the file.
+    path = tmp_path / "x.stl"
+    path.write_bytes(np.random.default_rng(5).integers(0, 256, 3000, dtype=np.uint8).tobytes())
+    with pytest.raises(ValueError, match=r"must be an STL file; it is neither ASCII STL") as error:
+        meshes.load(path)
+    assert "this file has 3000 bytes" in str(error.value)
+    assert "module" not in str(error.value)
+
+
+@pytest.mark.parametrize("binary", [True, False], ids=["binary", "ascii"])
+def test_a_valid_stl_passes_the_check(tmp_path, binary):
+    mesh = meshes.box([1.0, 2.0, 3.0])
+    path = tmp_path / "box.stl"
+    if binary:
+        meshes.save(mesh, path)
+    else:
+        path.write_text(mesh.export(file_type="stl_ascii"))
+    assert meshes.load(path).volume == pytest.approx(6.0)

@@ -271,11 +271,18 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
     if not file.is_file():
         raise _checks.fail("path", str(path), "an existing mesh file", remedy="not found")
     file_type = _suffix(file, LOAD_FORMATS, "path")
+    if file_type == "stl":
+        _check_stl(file, path)
     try:
         mesh = trimesh.load_mesh(file, file_type=file_type)
     except Exception as error:  # trimesh raises many types for a bad file
+        cause = (
+            "the reader needs an optional module that is missing"  # never an ImportError
+            if isinstance(error, ImportError)
+            else str(error)
+        )
         raise _checks.fail(
-            "path", str(path), f"a readable {file_type} mesh file", remedy=f"reading it: {error}"
+            "path", str(path), f"a readable {file_type} mesh file", remedy=f"reading it: {cause}"
         ) from error
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise _checks.fail(
@@ -285,6 +292,28 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
             remedy=f"it has none (empty or not a {file_type} file)",
         )
     return mesh
+
+
+def _check_stl(file: Path, path) -> None:
+    """Refuse a file that is neither ASCII STL (text starting ``solid``) nor binary STL (an
+    80-byte header, a triangle count n, then 50 bytes per triangle: 84 + 50 n bytes)."""
+    size = file.stat().st_size
+    with open(file, "rb") as handle:
+        head = handle.read(84)
+    if head[:5].lower() == b"solid":
+        try:
+            head.decode("ascii")
+            return
+        except UnicodeDecodeError:
+            pass  # a binary file whose header starts with "solid": check it as binary
+    count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
+    if count >= 0 and size == 84 + 50 * count:
+        return
+    raise _checks.fail(
+        "path", str(path), "an STL file",
+        remedy=f"it is neither ASCII STL (text starting 'solid') nor binary STL (84 + 50 n "
+        f"bytes for n triangles: this file has {size} bytes and its header says n = {count})",
+    )  # fmt: skip
 
 
 def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
