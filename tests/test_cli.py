@@ -265,3 +265,14 @@ def test_a_scenario_whose_stops_are_the_point_exits_0(tmp_path):
     assert result.exit_code == 0, result.output
     summary = json.loads((out / "summary.json").read_text())
     assert summary["schemes"]["explicit"]["status"] == -1
+
+
+def test_run_with_mp4_adds_animation_mp4(tmp_path):
+    # Issue 18 item 14: MP4 through imageio-ffmpeg's own binary, on every machine.
+    out = tmp_path / "spin"
+    result = runner.invoke(app, ["run", "t-handle", "--t-end", "2", "--mp4", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    with open(out / "animation.mp4", "rb") as file:
+        assert file.read(12)[4:8] == b"ftyp"
+    assert (out / "animation.gif").exists()
+    assert "animation.mp4" in json.loads((out / "summary.json").read_text())["files"]

@@ -72,10 +72,13 @@ def _progress(title: str) -> Iterator[Callable[[str], None]]:
         yield lambda stage: progress.update(task, description=f"{title}: {stage}")
 
 
-def _write(result: ScenarioResult, out: Path, force: bool, animation: bool, note) -> Path:
+def _write(
+    result: ScenarioResult, out: Path, force: bool, animation: bool, note, mp4: bool = False
+) -> Path:
     return write_run_folder(
-        result, out, force=force, animation=animation, on_file=lambda name: note(f"writing {name}")
-    )
+        result, out, force=force, animation=animation, mp4=mp4,
+        on_file=lambda name: note(f"writing {name}"),
+    )  # fmt: skip
 
 
 UNFINISHED = 3
@@ -166,6 +169,9 @@ def run(
         bool, typer.Option(help="Write animation.gif and view.html (slower).")
     ] = True,
     force: Force = False,
+    mp4: Annotated[
+        bool, typer.Option("--mp4", help="Also write animation.mp4 (H.264) beside the GIF.")
+    ] = False,
 ) -> None:
     """Run a scenario and write its run folder (data.nc, summary.json, pictures)."""
     from tumble.scenarios import files
@@ -183,8 +189,9 @@ def run(
             warnings.simplefilter("ignore", RuntimeWarning)  # overflow, nan: said in words below
             result = _run_scenario(name, options, None if target == name else target)
             folder = _write(
-                result, out or Path("runs") / default, force, animation and file_animation, note
-            )
+                result, out or Path("runs") / default, force, animation and file_animation, note,
+                mp4,
+            )  # fmt: skip
     _show_summary(name, result.summary, folder)
     stopped = result.unfinished()
     if stopped:

@@ -199,6 +199,7 @@ def write_run_folder(
     force: bool = False,
     animation: bool = True,
     on_file: Callable[[str], None] | None = None,
+    mp4: bool = False,
 ) -> Path:
     """Write a scenario's run folder: pictures, ``data.nc``, then ``summary.json``.
 
@@ -214,6 +215,9 @@ def write_run_folder(
         Write ``result.animations`` (``animation.gif``, ``view.html``) too.
     on_file : callable, optional
         Called with each file's name before it is written (for progress display).
+    mp4 : bool
+        With ``animation``, write ``animation.mp4`` beside ``animation.gif`` (the same
+        writer: the format comes from the suffix; ffmpeg from ``imageio-ffmpeg``).
 
     Returns
     -------
@@ -222,7 +226,10 @@ def write_run_folder(
     """
     out = prepare_folder(out, force=force)
     _forget_previous_run(out)
-    writers = list(result.figures) + (list(result.animations) if animation else [])
+    animations = list(result.animations) if animation else []
+    if mp4:
+        animations += [("animation.mp4", w) for name, w in animations if name == "animation.gif"]
+    writers = list(result.figures) + animations
     files = []
     notify = on_file or (lambda name: None)
     for name, writer in writers:

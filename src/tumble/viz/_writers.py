@@ -3,8 +3,8 @@
 The format comes from the path's suffix alone (:func:`animation_format`), so a temporary
 name such as ``.animation.partial.gif`` works. A GIF gets one palette for all frames
 (:data:`GIF_COLOURS` colours, the load arrows' :data:`LOAD_COLOURS` kept exact), so pixels
-that do not change cost nothing; an MP4 is H.264 in yuv420p and needs ``ffmpeg`` on ``PATH``
-(:func:`mp4_available`).
+that do not change cost nothing; an MP4 is H.264 in yuv420p through the ffmpeg that
+``imageio-ffmpeg`` ships (:func:`ffmpeg`, :func:`mp4_available`).
 
 Private: :mod:`tumble.viz.animation` re-exports :func:`mp4_available`,
 :func:`animation_format` and :func:`write_animation`, and draws the frames
@@ -38,9 +38,20 @@ LOAD_COLOURS = {"impulse": "tab:red", "force": "tab:orange"}
 """Colours of the load arrows (matplotlib names); a GIF's palette holds them exactly."""
 
 
+def ffmpeg() -> str | None:
+    """The ffmpeg executable: the one ``imageio-ffmpeg`` ships inside its wheel (a dependency,
+    so every install has it), else ``ffmpeg`` on ``PATH``, else None."""
+    try:
+        import imageio_ffmpeg
+
+        return imageio_ffmpeg.get_ffmpeg_exe()
+    except (ImportError, RuntimeError):  # not installed, or no binary for this platform
+        return shutil.which("ffmpeg")
+
+
 def mp4_available() -> bool:
-    """Whether ``ffmpeg`` is on ``PATH`` (needed to write ``.mp4``)."""
-    return shutil.which("ffmpeg") is not None
+    """Whether an ffmpeg is at hand to write ``.mp4`` (:func:`ffmpeg`)."""
+    return ffmpeg() is not None
 
 
 def animation_format(path: str | Path) -> str:
@@ -63,8 +74,9 @@ def animation_format(path: str | Path) -> str:
         )
     if suffix == ".mp4" and not mp4_available():
         raise RuntimeError(
-            f"path={str(path)!r}: writing .mp4 needs ffmpeg on PATH; install it "
-            "(e.g. apt-get install ffmpeg) or write a .gif"
+            f"path={str(path)!r}: writing .mp4 needs ffmpeg: imageio-ffmpeg (a dependency of "
+            "tumble) has no binary for this platform and there is none on PATH; install one "
+            "or write a .gif"
         )
     return suffix[1:]
 
@@ -103,7 +115,9 @@ def write_animation(images: Sequence[NDArray], path: str | Path, *, fps: float =
                                        loop=0, optimize=True),
         )  # fmt: skip
     height, width = images[0].shape[:2]
-    command = ["ffmpeg", "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
+    exe = ffmpeg()
+    assert exe is not None  # animation_format refused .mp4 without one
+    command = [exe, "-y", "-loglevel", "error", "-f", "rawvideo", "-pix_fmt", "rgb24",
                "-s", f"{width}x{height}", "-r", f"{fps:g}", "-i", "-",
                "-vf", "pad=ceil(iw/2)*2:ceil(ih/2)*2", "-c:v", "libx264",
                "-pix_fmt", "yuv420p", "-f", "mp4"]  # fmt: skip

@@ -302,7 +302,7 @@ def animate_body(
     ValueError
         Bad ``frames``, ``fps``, ``size``, ``loads`` or suffix of ``path``.
     RuntimeError
-        ``.mp4`` without ffmpeg on ``PATH``.
+        ``.mp4`` without an ffmpeg (imageio-ffmpeg ships one).
     """
     animation_format(path)  # refuse a bad suffix before rendering
     fps = _checks.positive("fps", fps, "frames per second")
