@@ -104,3 +104,23 @@ def test_lie_euler_on_the_sphere_keeps_every_invariant():
     run = simulate(RigidBody(1.0, np.eye(3)), 1.0, method="lie-euler", h=0.1, omega0=(1, 0, 0))
     assert run.energy_drift < 1e-15 and run.orthogonality_drift < 1e-15
     assert run.momentum_drift == 0.0
+
+
+def test_scipy_rotation_in_and_out():
+    # Issue 18 item 15: Trajectory.rotation is a scipy Rotation; simulate takes one as R0; the
+    # scalar-first quaternions of tumble and scipy's scalar-last ones convert both ways.
+    from scipy.spatial.transform import Rotation
+
+    start = Rotation.from_rotvec([0.3, -0.2, 0.9])
+    run = simulate(RigidBody(1.0, [1.0, 2.0, 3.0]), 2.0, h=0.01, R0=start, omega0=(0.1, 1.0, 0.2))
+    np.testing.assert_allclose(run.R[0], start.as_matrix(), atol=1e-15)
+    assert len(run.rotation) == len(run.t)
+    np.testing.assert_allclose(run.rotation.as_matrix(), run.R, atol=1e-14)
+    scalar_last = run.rotation.as_quat(canonical=True)  # [x, y, z, w], w ≥ 0
+    np.testing.assert_allclose(np.roll(scalar_last, 1, axis=1), run.q, atol=1e-14)
+    back = Rotation.from_quat(np.roll(run.q, -1, axis=1))  # scalar-first → scalar-last
+    np.testing.assert_allclose(back.as_matrix(), run.R, atol=1e-14)
+    with pytest.raises(
+        ValueError, match=r"^R0='<Rotation of 2>' is not allowed: must be a single"
+    ):
+        simulate(RigidBody(1.0, [1.0, 2.0, 3.0]), 1.0, h=0.1, R0=Rotation.random(2, rng=1))

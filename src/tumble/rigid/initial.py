@@ -51,7 +51,12 @@ def check_steps(method: Method, h, rtol, atol) -> tuple[float | None, float, flo
 
 
 def initial_attitude(R0, q0) -> np.ndarray:
-    """R0 (checked to be a rotation) or R from q0 (normalised; zero norm refused)."""
+    """R0 (checked to be a rotation; a single ``scipy.spatial.transform.Rotation`` is taken
+    as its matrix) or R from q0 (normalised; zero norm refused)."""
+    if R0 is not None and type(R0).__name__ == "Rotation" and hasattr(R0, "as_matrix"):
+        if not R0.single:
+            raise _checks.fail("R0", f"<Rotation of {len(R0)}>", "a single rotation")
+        R0 = R0.as_matrix()
     if R0 is not None and q0 is not None:
         raise _checks.fail(
             "q0",

@@ -192,6 +192,22 @@ class Trajectory:
         arm = self.x - np.asarray(point, dtype=float)
         return self.L_world + self.body.mass * np.cross(arm, self.v)
 
+    @property
+    def rotation(self):
+        """The attitudes as one ``scipy.spatial.transform.Rotation`` of ``n`` rotations (for
+        the ``matrix`` methods, scipy takes the nearest rotation of each R).
+
+        Examples
+        --------
+        >>> from tumble.rigid import RigidBody, simulate
+        >>> run = simulate(RigidBody(1.0, [1.0, 1.0, 1.0]), 1.0, h=0.5, omega0=(0.0, 0.0, 1.0))
+        >>> len(run.rotation), round(float(run.rotation[-1].magnitude()), 12)
+        (3, 1.0)
+        """
+        from scipy.spatial.transform import Rotation
+
+        return Rotation.from_matrix(self.R)
+
     def euler_zyx(self) -> np.ndarray:
         """ZYX Euler angles ``(φ_z, θ_y, ψ_x)`` in rad, shape (n, 3); see :mod:`tumble.so3`."""
         return so3.euler_zyx_from_matrix(self.R)
