@@ -167,7 +167,8 @@ def simulate(
         (at most one; default at rest).
     forces : sequence
         :class:`~tumble.Gravity`, :class:`~tumble.Force`, :class:`~tumble.Torque`,
-        :class:`~tumble.Impulse` (a step lands on each impulse's time).
+        :class:`~tumble.MagneticDipole`, :class:`~tumble.Impulse` (a step lands on each
+        impulse's time, which must lie within the run).
     events : sequence of callables
         ``g(t, state) -> float`` with ``terminal``/``direction`` as in :func:`tumble.solve`;
         ``state`` is a :class:`~tumble.rigid.forces.State`.
