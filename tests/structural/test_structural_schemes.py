@@ -178,9 +178,11 @@ def test_initial_state_is_taken_from_x0_and_y0(beam, dt):
 def test_divergence_is_a_status_with_the_time(beam, dt):
     run = structural.integrate(beam, "semi-implicit", dt, n_steps=STEPS)
     assert not run.success
-    assert "non-finite" in run.message and f"from t={float(run.t[-1])!r} to" in run.message
+    # the energy overflows (at |x| ≈ 1e150) before the state does: that ends the records
+    assert "energy stopped being finite" in run.message
+    assert f"t={float(run.t[-1])!r}" in run.message
     assert run.t[-1] < STEPS * dt
-    assert np.all(np.isfinite(run.x[-1]))  # the run ends with the last finite state
+    assert np.all(np.isfinite(run.x[-1])) and np.all(np.isfinite(run.energy))
 
 
 def test_progress_bar_does_not_change_the_result(beam, dt):
@@ -235,3 +237,18 @@ def test_rayleigh_damping_rejects_negative_coefficients():
         ValueError, match=r"mass_coefficient=-1.0 is not allowed: must be finite and >= 0"
     ):
         structural.RayleighDamping(mass_coefficient=-1.0)
+
+
+def test_a_run_whose_energy_overflows_is_reported_as_failed():
+    # Issue 18: an explicit run past its step limit ended with the state at 1e180, finite,
+    # its energy NaN, and status 0. It now ends with the last record of finite energy.
+    import warnings
+
+    beam = structural.cantilever(1.0, 20, 210e9, 7850.0, 0.01, 0.01, 1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # and no numpy warning on the way
+        run = structural.integrate(beam, "explicit", 6e-4, n_steps=80)
+    assert run.status == -1
+    assert "energy stopped being finite" in run.message and "t=" in run.message
+    assert np.all(np.isfinite(run.energy)) and np.all(np.isfinite(run.x))
+    assert len(run.t) == len(run.x) == len(run.energy) < 81

@@ -183,7 +183,8 @@ class Response:
         The system's monitored DOF.
     status : Status
         ``Status.SUCCESS``, or ``Status.FAILED`` if the state became non-finite (inf or
-        NaN); the run stops there and its last record is the last finite state.
+        NaN), or its energy did (a state past 1e150 overflows ``½ xᵀ S x``); the records
+        end with the last one where both are finite.
     message : str
         What happened, naming the step's times on failure.
     solver : str
@@ -309,8 +310,20 @@ def integrate(
                     progress=advance if progress else None)  # fmt: skip
         energy = system.energy(*out.records)
     xs, ys = out.records
-    return Response(out.t, xs, ys, energy, scheme.name, dt, system.tip_dof, out.status,
-                    out.message, solver)  # fmt: skip
+    t, status, message = out.t, out.status, out.message
+    overflowed = ~np.isfinite(energy)
+    if overflowed.any():  # a finite state whose energy is not: the run ends before it
+        first = max(int(np.argmax(overflowed)), 1)
+        size = float(np.max(np.abs(xs[first])))
+        status = Status.FAILED
+        message = (
+            f"the energy stopped being finite at t={float(t[first])!r} (the displacements "
+            f"reach {size:.3g}, finite, but ½ xᵀ S x overflows); the run ends with the last "
+            f"record whose energy is finite, t={float(t[first - 1])!r}"
+        )
+        t, xs, ys, energy = t[:first], xs[:first], ys[:first], energy[:first]
+    return Response(t, xs, ys, energy, scheme.name, dt, system.tip_dof, status, message,
+                    solver)  # fmt: skip
 
 
 def _choose_stepper(

@@ -233,7 +233,8 @@ def stability_sweep(
         run = integrate(
             system, scheme, float(dt), n_steps=n_steps, x0=x0, y0=y0, record_every=record_every
         )
-        rise = np.max(run.energy - run.energy[0]) / scale
+        with np.errstate(over="ignore"):  # a diverging run's energy can reach 1e300
+            rise = np.max(run.energy - run.energy[0]) / scale
         growth[i] = rise if run.success and np.isfinite(rise) else np.inf
     critical = critical_dt(system, scheme)
     return StabilitySweep(
