@@ -41,9 +41,11 @@ H_GRID = (0.2, 0.1, 0.05, 0.04, 0.025, 0.02, 0.0125, 0.01, 0.005, 0.0025)
 H_GRID_ORDER8 = (1.0, 0.8, 0.625, 0.5, 0.4, 0.3125, 0.25, 0.2, 0.1, 0.05)
 """``rkmk8``'s steps: T/h = 100, 125, 160, …, a factor of 1.25 apart, coarser than DOP853's
 rtol grid (a factor √10 in rtol is about 1.14 in its steps)."""
-H_GRID_ORDER2 = (0.02, 0.01, 0.005, 0.0025, 0.00125, 6.25e-4, 3.125e-4, 1.5625e-4, 7.8125e-5)
-"""The order-2 splittings' steps: they need h ≈ 1e-3 … 1e-4 for 1e-6 at T = 100, and no h of
-a sensible run reaches 1e-9 (reported as not reached)."""
+H_GRID_ORDER2 = tuple(0.02 / 2**k for k in range(13))  # 0.02 … 4.8828125e-6
+"""The order-2 methods' steps, halving: they need h ≈ 1e-3 … 1e-4 for 1e-6 at T = 100 and
+h ≈ 2e-5 … 5e-6 (5·10⁶ … 2·10⁷ steps, a second or two) for 1e-9. The grid stops there: below
+h ≈ 1e-5 round-off over 10⁷ steps takes over (``split-axes``: 3.0e-10 at h = 9.8e-6, 1.3e-9
+at 4.9e-6), so a finer h would not help."""
 H_GRID_EXACT = (10.0, 5.0, 2.0, 1.0)
 """The methods on the exact flow: round-off at any h, so the coarsest step wins."""
 WORK_PRECISION_METHODS = {
@@ -677,8 +679,10 @@ def main(argv: list[str] | None = None) -> str:
             wp_rows,
         ),
         "",
-        "h: the largest of the method's grid that meets the error (`rkmk4`: 0.2 … 0.0025; "
-        "`rkmk8`: T/h = 100, 125, 160, 200, … a factor 1.25 apart); rtol: the loosest of "
+        "h: the largest of the method's grid that meets the error (`rkmk4`, `split-axes4`: "
+        "0.2 … 0.0025; `rkmk8`: T/h = 100, 125, 160, 200, … a factor 1.25 apart; the order-2 "
+        "`split-axes`, `midpoint-lp`, `dmv`: 0.02 halved down to 4.9e-6, T/h up to 2·10⁷, "
+        "past which round-off grows faster than the error falls); rtol: the loosest of "
         "10^(−k/2) that does (atol = rtol·1e-3), about 1.14 apart in DOP853's steps. The "
         "last column divides by tumble's best time at that error. solve_ivp integrates "
         "Euler's equations + the quaternion with a lean Python right-hand side (f: its "
