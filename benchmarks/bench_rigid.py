@@ -426,9 +426,9 @@ def batch_rows(problem: Problem, sizes, repeat: int, budget: int) -> tuple[list,
 # --- 4. simulate's overhead, 5. plain NumPy RK4 ---------------------------------------------
 
 
-def overhead(problem: Problem, repeat: int) -> tuple[float, float, float]:
+def overhead(problem: Problem, repeat: int, method: str = "rkmk4") -> tuple[float, float, float]:
     """A 10-step ``simulate`` call (the steps themselves cost a few µs)."""
-    times = [timed(lambda: tumble_run(problem, "rkmk4", H, 10 * H), 1)[0] for _ in range(repeat)]
+    times = [timed(lambda: tumble_run(problem, method, H, 10 * H), 1)[0] for _ in range(repeat)]
     return float(np.median(times)), float(np.min(times)), float(np.max(times))
 
 
@@ -776,14 +776,14 @@ def main(argv: list[str] | None = None) -> str:
     split = numbers["P1"].get("split-axes")
     if split is not None and not split_axes_met(numbers["P1"]):
         marginal = numbers["P1"]["split-axes marginal"]
+        call = overhead(p1, 50 if args.quick else 200, "split-axes")
         floors = split_axes_floors(200_000 if args.quick else 1_000_000)
         notes.append(
             f"`split-axes` at {split[0] * 1e9:.0f} ns a step over a 10⁴-step `simulate` call "
             f"(issue #12: ≤ 100 ns). The steps alone cost {marginal[0] * 1e9:.0f} ns "
-            f"({marginal[1] * 1e9:.0f}–{marginal[2] * 1e9:.0f}), so "
-            f"{(split[0] - marginal[0]) * 1e9:.0f} ns a step is the call's fixed cost, "
-            f"{(split[0] - marginal[0]) * 1e10:.0f} µs spread over 10⁴ steps (a 10-step "
-            f"`rkmk4` call: {over[0] * 1e6:.0f} µs, section 4). Floor of the steps: a "
+            f"({marginal[1] * 1e9:.0f}–{marginal[2] * 1e9:.0f}); the call's fixed cost, a "
+            f"10-step `split-axes` call, is {spread(*call, 1e6, 0)} µs, "
+            f"{call[0] * 1e5:.0f} ns a step over 10⁴ steps. Floor of the steps: a "
             "compiled loop doing nothing but split-axes' sin/cos pairs, each angle waiting for "
             f"the rotation before it as h m_i/I_i does, takes {floors['chain5'] * 1e9:.0f} ns a "
             f"step for five pairs (a Strang step 1, 2, 3, 2, 1) and "
