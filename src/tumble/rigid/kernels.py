@@ -449,14 +449,16 @@ def _axes_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
     about axis 1 go by ``head/2`` and ``tail/2`` instead of ``h/2`` (0: left out): axis 1's
     turn leaves ``m₁`` alone, so the last turn of a step and the first of the next are one
     turn by their sum, which the loop takes when nothing happens between them."""
+    # the factors h/(2Iᵢ) off the chain of dependent rotations: a product on it, not a division
+    a0, a1, a2 = 0.5 / moments[0], 0.5 * h / moments[1], h / moments[2]
     m0, m1, m2 = _apply_transpose(Rp, L0, L1, L2)
     if head != 0.0:
-        m0, m1, m2 = _turn(Rp, m0, m1, m2, 0, 0.5 * head * m0 / moments[0])
-    m0, m1, m2 = _turn(Rp, m0, m1, m2, 1, 0.5 * h * m1 / moments[1])
-    m0, m1, m2 = _turn(Rp, m0, m1, m2, 2, h * m2 / moments[2])
-    m0, m1, m2 = _turn(Rp, m0, m1, m2, 1, 0.5 * h * m1 / moments[1])
+        m0, m1, m2 = _turn(Rp, m0, m1, m2, 0, head * a0 * m0)
+    m0, m1, m2 = _turn(Rp, m0, m1, m2, 1, a1 * m1)
+    m0, m1, m2 = _turn(Rp, m0, m1, m2, 2, a2 * m2)
+    m0, m1, m2 = _turn(Rp, m0, m1, m2, 1, a1 * m1)
     if tail != 0.0:
-        _turn(Rp, m0, m1, m2, 0, 0.5 * tail * m0 / moments[0])
+        _turn(Rp, m0, m1, m2, 0, tail * a0 * m0)
     return True
 
 
