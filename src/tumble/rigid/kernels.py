@@ -551,8 +551,8 @@ _RF_Q = (3.0 * _EPS) ** (-1.0 / 6.0)
 _RJ_Q = (0.25 * _EPS) ** (-1.0 / 6.0)
 SYMMETRY_RTOL, SEPARATRIX_RTOL, M1_MIN, AGM_MAX_STEPS = 1e-12, 1e-12, 1e-300, 64
 """As :mod:`tumble._elliptic` (a test checks they agree)."""
-WORK_SIZE = AGM_MAX_STEPS + 14
-"""A flow's work array: the AGM's ratios, then ω at 0 and h, Π at 0 and h, l at 0 and h."""
+WORK_SIZE = AGM_MAX_STEPS + 8
+"""A flow's work array: the AGM's ratios, then ω at 0 and h (6), then Π at 0 and h (2)."""
 
 
 @njit(**_JIT)
@@ -849,7 +849,9 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
 
     ``z = (x, p, L)`` and ``Rn = R_p`` hold the state and are updated in place. Returns
     ``(recorded, failed, cause)`` as :func:`_loop`; a failed step leaves the state at the
-    step before.
+    step before. Without loads the kicks are skipped, and where ``MERGES`` (the axes flow)
+    the last half turn of one sub-step and the first of the next are done as one turn,
+    settled before every recorded step, at the block's end and on failure.
     """
     t_a, t_b, h, n = grid
     weights, mass = problem.b, problem.m
