@@ -2,8 +2,11 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tumble import solve
+from tumble.ode.events import SAMPLES_PER_STEP
 
 
 def oscillator(t, y):
@@ -100,3 +103,34 @@ def test_bad_direction_attribute_is_refused():
     event = _event(position, direction=2)
     with pytest.raises(ValueError, match="direction"):
         solve(oscillator, (0, 1), [1, 0], h=0.1, events=event)
+
+
+def test_two_crossings_inside_one_step_are_both_found():
+    # The case: rk4 with h = 4 on y'' = -y. Step [4, 8] holds two zeros of its own
+    # dense output, with g of one sign at both ends; every zero of the interpolant is found.
+    event = _event(position)
+    result = solve(oscillator, (0, 12), [1, 0], method="rk4", h=4, events=event, dense_output=True)
+    times = np.linspace(0, 12, 120_001)
+    values = result.sol(times)[0]
+    zeros = times[np.flatnonzero(np.diff(np.sign(values)))]
+    assert len(result.t_events[0]) == len(zeros) == 3
+    np.testing.assert_allclose(result.t_events[0], zeros, atol=1e-4)
+
+
+@settings(max_examples=60, deadline=None)
+@given(frequency=st.floats(0.5, 20.0), phase=st.floats(0.0, 2 * np.pi), steps=st.integers(1, 30))
+def test_every_crossing_farther_apart_than_a_sub_interval_is_found(frequency, phase, steps):
+    # g = sin(ωt + φ) has zeros π/ω apart; with h < SAMPLES_PER_STEP π/ω none may be missed.
+    t_end = 10.0
+    h = min(t_end / steps, 0.95 * SAMPLES_PER_STEP * np.pi / frequency)
+
+    def g(t, y):
+        return np.sin(frequency * t + phase)
+
+    result = solve(lambda t, y: -y, (0, t_end), [1.0], h=h, events=g)
+    k = np.arange(np.ceil(phase / np.pi), np.floor((frequency * t_end + phase) / np.pi) + 1)
+    zeros = (k * np.pi - phase) / frequency
+    inside = (zeros > 1e-6) & (zeros < t_end - 1e-6)  # g(0), g(t_end) may round to either sign
+    found = np.asarray(result.t_events[0])
+    found = found[(found > 1e-6) & (found < t_end - 1e-6)]
+    np.testing.assert_allclose(found, zeros[inside], atol=1e-9)

@@ -121,3 +121,23 @@ def test_implicit_tableau_is_refused():
 def test_tableau_coefficients_are_read_only():
     with pytest.raises(ValueError, match="read-only"):
         TABLEAUX["rk4"].b[0] = 1.0
+
+
+def test_continuous_extension_without_its_order_is_refused():
+    with pytest.raises(ValueError, match="dense_order"):
+        ButcherTableau(name="bad", c=[0.0], A=[[0.0]], b=[1.0], order=1, dense=[[1.0]])
+
+
+def test_continuous_extension_that_misses_the_step_at_theta_one_is_refused():
+    with pytest.raises(ValueError, match="equal b at θ = 1"):
+        ButcherTableau(
+            name="bad", c=[0.0], A=[[0.0]], b=[1.0], order=1, dense=[[0.9]], dense_order=1
+        )
+
+
+def test_extra_dense_stages_of_the_wrong_shape_are_refused():
+    with pytest.raises(ValueError, match="dense_A must be"):
+        ButcherTableau(
+            name="bad", c=[0.0], A=[[0.0]], b=[1.0], order=1, dense=[[1.0], [0.0], [0.0]],
+            dense_c=[0.5], dense_A=[[0.5]], dense_order=1,
+        )  # fmt: skip

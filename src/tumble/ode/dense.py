@@ -6,9 +6,10 @@ Every step's interpolant has the form
 
     y(t_n + \\theta h) = y_n + h \\sum_{j=1}^{q} Q_j \\theta^j, \\qquad 0 \\le \\theta \\le 1,
 
-where ``Q`` comes from the tableau's own continuous extension (``Q = Kᵀ P``) or, for tableaux
-without one, from the cubic Hermite interpolant through ``(y_n, f_n)`` and ``(y_{n+1},
-f_{n+1})``.
+where ``Q`` comes from the tableau's own continuous extension (``Q = Kᵀ P``; DOP853's order-7
+one adds three stages) or, for tableaux without one, from the cubic Hermite interpolant through
+``(y_n, f_n)`` and ``(y_{n+1}, f_{n+1})``. :attr:`ButcherTableau.interpolant_order
+<tumble.ode.tableaux.ButcherTableau.interpolant_order>` states each one's order.
 """
 
 from __future__ import annotations
@@ -41,11 +42,27 @@ def step_coefficients(
     y1: np.ndarray,
     f1: np.ndarray,
     h: float,
+    fun: Callable[[float, np.ndarray], np.ndarray] | None = None,
+    t0: float = 0.0,
 ) -> np.ndarray:
-    """The interpolant's coefficients ``Q`` for one step, shape (n, q)."""
-    if tableau.dense is not None:
+    """The interpolant's coefficients ``Q`` for one step ``[t0, t0 + h]``, shape (n, q).
+
+    A tableau with extra dense-output stages (DOP853's three) evaluates ``fun`` for them here,
+    so only a run that asks for dense output or events pays for them.
+    """
+    if tableau.dense is None:
+        return hermite_coefficients(y0, y1, K[0], f1, h)
+    if tableau.dense_A is None or tableau.dense_c is None:
         return K.T @ tableau.dense
-    return hermite_coefficients(y0, y1, K[0], f1, h)
+    if fun is None:
+        raise ValueError(f"{tableau.name}'s dense output needs the right-hand side fun")
+    s = tableau.stages
+    extended = np.empty((s + 1 + tableau.extra_stages, y0.size))
+    extended[:s], extended[s] = K[:s], f1
+    for j, (row, c) in enumerate(zip(tableau.dense_A, tableau.dense_c, strict=True)):
+        i = s + 1 + j
+        extended[i] = fun(t0 + c * h, y0 + h * (row[:i] @ extended[:i]))
+    return extended.T @ tableau.dense
 
 
 class StepInterpolant:
@@ -66,22 +83,20 @@ class StepInterpolant:
 class DenseOutput:
     """The continuous solution over the whole run, like scipy's ``OdeSolution``.
 
-        Parameters
-        ----------
-        ts : ndarray, shape (m + 1,)
-            Step boundaries, increasing.
-        interpolants : list of StepInterpolant
-            One per step.
+    Parameters
+    ----------
+    ts : ndarray, shape (m + 1,)
+        Step boundaries, increasing.
+    interpolants : list of StepInterpolant
+        One per step.
 
-        Examples
-        --------
-        >>> from collections.abc import Callable, Sequence
-
-    import numpy as np
-        >>> from tumble import solve
-        >>> result = solve(lambda t, y: -y, (0.0, 1.0), [1.0], method="dopri5", dense_output=True)
-        >>> bool(abs(result.sol(0.5)[0] - np.exp(-0.5)) < 1e-6)
-        True
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tumble import solve
+    >>> result = solve(lambda t, y: -y, (0.0, 1.0), [1.0], method="dopri5", dense_output=True)
+    >>> bool(abs(result.sol(0.5)[0] - np.exp(-0.5)) < 1e-6)
+    True
     """
 
     def __init__(self, ts: Sequence[float] | np.ndarray, interpolants: Sequence[Callable]):

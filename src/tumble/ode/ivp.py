@@ -96,7 +96,7 @@ class RungeKutta(Stepper):
 
     def interpolant(self, t_old, old, t_new, new) -> StepInterpolant:
         h = t_new - t_old
-        Q = step_coefficients(self.tableau, self.K, old, new, self.f, h)
+        Q = step_coefficients(self.tableau, self.K, old, new, self.f, h, self.fun, t_old)
         return StepInterpolant(t_old, h, old, Q)
 
 

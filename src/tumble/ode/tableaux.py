@@ -63,9 +63,18 @@ class ButcherTableau:
         Order of the embedded solution.
     fsal : bool
         First same as last: the last stage is ``f(t + h, y_{n+1})`` (its row of ``A`` is ``b``).
-    dense : array_like, shape (s, q), optional
+    dense : array_like, shape (s, q) or (s + 1 + m, q), optional
         The method's own continuous extension: ``y(t + θh) = y + h Σ_i k_i Σ_j P_ij θ^(j+1)``.
         Without it, dense output is the cubic Hermite interpolant.
+    dense_c, dense_A : array_like, shapes (m,) and (m, s + 1 + m), optional
+        Extra stages that only the continuous extension uses, computed after an accepted step
+        when dense output is asked for. The stages are extended as
+        ``k_{s+1} = f(t + h, y_{n+1})`` (known already) then
+        ``k_{s+1+j} = f(t + c_j h, y + h Σ_i a_ji k_i)``; ``dense`` then has ``s + 1 + m`` rows.
+    dense_order : int, optional
+        Order ``q`` of the continuous extension (required with ``dense``), in the sense of
+        Hairer, Nørsett & Wanner §II.6: its local error at any ``θ`` is ``O(h^(q+1))``, so the
+        dense output's global error is ``O(h^min(p, q+1))``.
     reference : str
         Where the coefficients come from.
 
@@ -86,6 +95,9 @@ class ButcherTableau:
     order_hat: int | None = None
     fsal: bool = False
     dense: Coefficients | None = None
+    dense_c: Coefficients | None = None
+    dense_A: Coefficients | None = None
+    dense_order: int | None = None
     reference: str = ""
     e: np.ndarray | None = field(init=False, default=None)
     rows: tuple = field(init=False, default=(), repr=False)
@@ -98,8 +110,9 @@ class ButcherTableau:
         if self.b_hat is not None:
             set_(self, "b_hat", _frozen(self.b_hat, 1))
             set_(self, "e", _frozen(self.b - self.b_hat, 1))
-        if self.dense is not None:
-            set_(self, "dense", _frozen(self.dense, 2))
+        for name, ndim in (("dense", 2), ("dense_c", 1), ("dense_A", 2)):
+            if getattr(self, name) is not None:
+                set_(self, name, _frozen(getattr(self, name), ndim))
         self._check()
         rows = tuple((self.A[i, :i].copy(), float(self.c[i])) for i in range(1, self.stages))
         set_(self, "rows", rows)  # stage rows pre-sliced for the stepper's inner loop
@@ -118,11 +131,46 @@ class ButcherTableau:
             raise ValueError(f"{self.name}: the error weights b - b_hat must sum to 0")
         if self.fsal and not (np.array_equal(self.A[-1], self.b) and self.c[-1] == 1.0):
             raise ValueError(f"{self.name}: a FSAL tableau's last row of A must equal b")
+        if self.dense is not None:
+            self._check_dense(self.dense)
+
+    def _check_dense(self, dense: np.ndarray) -> None:
+        s, m = self.stages, self.extra_stages
+        rows = s if m == 0 and self.dense_A is None else s + 1 + m
+        if self.dense_order is None:
+            raise ValueError(f"{self.name}: a continuous extension must declare dense_order")
+        if dense.shape[0] != rows:
+            raise ValueError(f"{self.name}: dense must have {rows} rows, one per stage")
+        if self.dense_A is not None and (
+            self.dense_c is None or self.dense_A.shape != (m, s + 1 + m)
+        ):
+            raise ValueError(f"{self.name}: dense_A must be ({m}, {s + 1 + m}) with dense_c")
+        weights = np.zeros(rows)
+        weights[:s] = self.b
+        scale = np.maximum(1.0, np.abs(dense).sum(axis=1))  # large terms cancel at θ = 1
+        if np.any(np.abs(dense.sum(axis=1) - weights) > _TOL * scale):
+            raise ValueError(f"{self.name}: the continuous extension must equal b at θ = 1")
 
     @property
     def stages(self) -> int:
         """Number of stages ``s``."""
         return self.c.shape[0]
+
+    @property
+    def extra_stages(self) -> int:
+        """Number ``m`` of stages that only the continuous extension uses."""
+        return 0 if self.dense_c is None else self.dense_c.shape[0]
+
+    @property
+    def interpolant_order(self) -> int:
+        """Order ``q`` of the dense output: the extension's, or the cubic Hermite's ``min(p, 3)``.
+
+        The local error between the nodes is ``O(h^(q+1))``; the global error of the dense
+        output is ``O(h^min(p, q+1))``.
+        """
+        if self.dense_order is not None:
+            return self.dense_order
+        return min(self.order, 3)
 
     @property
     def adaptive(self) -> bool:
@@ -227,11 +275,125 @@ DORMAND_PRINCE54 = ButcherTableau(
         [0, -282668133 / 205662961, 2019193451 / 616988883, -1453857185 / 822651844],
         [0, 40617522 / 29380423, -110615467 / 29380423, 69997945 / 29380423],
     ],
+    dense_order=4,
     reference=(
         "Dormand, J. R. & Prince, P. J. (1980). A family of embedded Runge-Kutta formulae. "
         "J. Comp. Appl. Math. 6(1), 19-26; dense output of Shampine (1986), as in scipy's RK45."
     ),
 )
+
+_DOP853_B = [
+    5.42937341165687622380535766363e-2,
+    0,
+    0,
+    0,
+    0,
+    4.45031289275240888144113950566,
+    1.89151789931450038304281599044,
+    -5.8012039600105847814672114227,
+    3.1116436695781989440891606237e-1,
+    -1.52160949662516078556178806805e-1,
+    2.01365400804030348374776537501e-1,
+    4.47106157277725905176885569043e-2,
+]
+
+# DOP853's dense output (dop853.f, CONTD8): three extra stages after k_13 = f(t + h, y_{n+1}),
+# each row over the 16 extended stages, and the rows D of the interpolant's last four terms.
+_DOP853_EXTRA_A = [
+    [
+        5.61675022830479523392909219681e-2, 0, 0, 0, 0, 0,
+        2.53500210216624811088794765333e-1,
+        -2.46239037470802489917441475441e-1,
+        -1.24191423263816360469010140626e-1,
+        1.5329179827876569731206322685e-1,
+        8.20105229563468988491666602057e-3,
+        7.56789766054569976138603589584e-3,
+        -8.298e-3, 0, 0, 0,
+    ],
+    [
+        3.18346481635021405060768473261e-2, 0, 0, 0, 0,
+        2.83009096723667755288322961402e-2,
+        5.35419883074385676223797384372e-2,
+        -5.49237485713909884646569340306e-2,
+        0, 0,
+        -1.08347328697249322858509316994e-4,
+        3.82571090835658412954920192323e-4,
+        -3.40465008687404560802977114492e-4,
+        1.41312443674632500278074618366e-1,
+        0, 0,
+    ],
+    [
+        -4.28896301583791923408573538692e-1, 0, 0, 0, 0,
+        -4.69762141536116384314449447206,
+        7.68342119606259904184240953878,
+        4.06898981839711007970213554331,
+        3.56727187455281109270669543021e-1,
+        0, 0, 0,
+        -1.39902416515901462129418009734e-3,
+        2.9475147891527723389556272149,
+        -9.15095847217987001081870187138,
+        0,
+    ],
+]  # fmt: skip
+_DOP853_D = [
+    [
+        -0.84289382761090128651353491142e1, 0, 0, 0, 0,
+        0.56671495351937776962531783590, -0.30689499459498916912797304727e1,
+        0.23846676565120698287728149680e1, 0.21170345824450282767155149946e1,
+        -0.87139158377797299206789907490, 0.22404374302607882758541771650e1,
+        0.63157877876946881815570249290, -0.88990336451333310820698117400e-1,
+        0.18148505520854727256656404962e2, -0.91946323924783554000451984436e1,
+        -0.44360363875948939664310572000e1,
+    ],
+    [
+        0.10427508642579134603413151009e2, 0, 0, 0, 0,
+        0.24228349177525818288430175319e3, 0.16520045171727028198505394887e3,
+        -0.37454675472269020279518312152e3, -0.22113666853125306036270938578e2,
+        0.77334326684722638389603898808e1, -0.30674084731089398182061213626e2,
+        -0.93321305264302278729567221706e1, 0.15697238121770843886131091075e2,
+        -0.31139403219565177677282850411e2, -0.93529243588444783865713862664e1,
+        0.35816841486394083752465898540e2,
+    ],
+    [
+        0.19985053242002433820987653617e2, 0, 0, 0, 0,
+        -0.38703730874935176555105901742e3, -0.18917813819516756882830838328e3,
+        0.52780815920542364900561016686e3, -0.11573902539959630126141871134e2,
+        0.68812326946963000169666922661e1, -0.10006050966910838403183860980e1,
+        0.77771377980534432092869265740, -0.27782057523535084065932004339e1,
+        -0.60196695231264120758267380846e2, 0.84320405506677161018159903784e2,
+        0.11992291136182789328035130030e2,
+    ],
+    [
+        -0.25693933462703749003312586129e2, 0, 0, 0, 0,
+        -0.15418974869023643374053993627e3, -0.23152937917604549567536039109e3,
+        0.35763911791061412378285349910e3, 0.93405324183624310003907691704e2,
+        -0.37458323136451633156875139351e2, 0.10409964950896230045147246184e3,
+        0.29840293426660503123344363579e2, -0.43533456590011143754432175058e2,
+        0.96324553959188282948394950600e2, -0.39177261675615439165231486172e2,
+        -0.14972683625798562581422125276e3,
+    ],
+]  # fmt: skip
+
+
+def _dop853_extension() -> np.ndarray:
+    """DOP853's interpolant in this module's form ``P`` (16 stages × θ¹…θ⁷).
+
+    dop853.f writes ``y(t + θh) = y + Σ_k F_k w_k(θ)`` with ``w = θ, θ(1-θ), θ²(1-θ),
+    θ²(1-θ)², θ³(1-θ)², θ³(1-θ)³, θ⁴(1-θ)³`` and ``F_k = h G_k · k``: ``G_0 = b``,
+    ``G_1 = e_1 - b``, ``G_2 = 2b - e_1 - e_13``, ``G_3…6 = D``. Then ``P = Gᵀ W``, with ``W``
+    the power coefficients of ``w``.
+    """
+    b = np.zeros(16)
+    b[:12] = _DOP853_B
+    first, new = np.eye(16)[0], np.eye(16)[12]
+    G = np.vstack([b, first - b, 2 * b - first - new, np.array(_DOP853_D)])
+    theta, one_minus = np.polynomial.Polynomial([0, 1]), np.polynomial.Polynomial([1, -1])
+    powers = [(1, 0), (1, 1), (2, 1), (2, 2), (3, 2), (3, 3), (4, 3)]
+    W = np.zeros((7, 7))
+    for k, (i, j) in enumerate(powers):
+        W[k, : i + j] = (theta**i * one_minus**j).coef[1:]
+    return G.T @ W
+
 
 # dop853.f's digits (30 significant); as doubles they equal scipy's arrays bit for bit.
 DORMAND_PRINCE8 = ButcherTableau(
@@ -334,27 +496,19 @@ DORMAND_PRINCE8 = ButcherTableau(
             ],
         ]
     ),
-    b=[
-        5.42937341165687622380535766363e-2,
-        0,
-        0,
-        0,
-        0,
-        4.45031289275240888144113950566,
-        1.89151789931450038304281599044,
-        -5.8012039600105847814672114227,
-        3.1116436695781989440891606237e-1,
-        -1.52160949662516078556178806805e-1,
-        2.01365400804030348374776537501e-1,
-        4.47106157277725905176885569043e-2,
-    ],
+    b=_DOP853_B,
     order=8,
+    dense_c=[0.1, 0.2, 0.777777777777777777777777777778],
+    dense_A=_DOP853_EXTRA_A,
+    dense=_dop853_extension(),
+    dense_order=7,
     reference=(
         "Hairer, E., Nørsett, S. P. & Wanner, G. (1993). Solving Ordinary Differential "
         "Equations I, 2nd ed., §II.10: the 12 stages and eighth-order weights of Dormand and "
         "Prince's DOP853 (the coefficients of Hairer's dop853.f, as in scipy's "
-        "integrate/_ivp/dop853_coefficients.py). Fixed step: DOP853's error estimators of "
-        "orders 5 and 3 and its extra dense-output stages are left out."
+        "integrate/_ivp/dop853_coefficients.py), and DOP853's seventh-order dense output "
+        "(three extra stages, dop853.f's CONTD8). Fixed step: DOP853's error estimators of "
+        "orders 5 and 3 are left out."
     ),
 )
 
