@@ -276,3 +276,34 @@ def test_run_with_mp4_adds_animation_mp4(tmp_path):
         assert file.read(12)[4:8] == b"ftyp"
     assert (out / "animation.gif").exists()
     assert "animation.mp4" in json.loads((out / "summary.json").read_text())["files"]
+
+
+@pytest.mark.parametrize("signal_name", ["SIGTERM", "SIGINT"])
+def test_a_killed_run_exits_130_and_leaves_no_partial_files(tmp_path, signal_name):
+    # Wait until a file is being written, then stop the run as a scheduler or Ctrl-C would.
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "run"
+    command = [str(Path(sys.executable).with_name("tumble")), "run", "t-handle", "--out", str(out)]
+    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and process.poll() is None:
+        if out.is_dir() and any(".partial" in f.name for f in out.iterdir()):
+            break
+        time.sleep(0.002)
+    process.send_signal(getattr(signal, signal_name))
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr.decode()
+    assert "Traceback" not in stderr.decode()
+    assert not [f.name for f in out.iterdir() if ".partial" in f.name]
+
+
+def test_out_under_a_regular_file_exits_2_naming_it(tmp_path):
+    (tmp_path / "plain").write_text("x")
+    out = tmp_path / "plain" / "run"
+    result = runner.invoke(app, ["run", "projectile", "--out", str(out)])
+    assert result.exit_code == 2
+    assert "cannot be created" in result.output and "Traceback" not in result.output

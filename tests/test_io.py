@@ -9,7 +9,7 @@ import xarray as xr
 
 import tumble
 from tumble import io, scenarios
-from tumble.io import ScenarioResult, atomic_write, write_json
+from tumble.io import ScenarioResult, atomic_write, write_json, write_run_folder
 from tumble.rigid import Trajectory
 
 
@@ -166,3 +166,72 @@ def test_atomic_write_gives_the_mode_an_ordinary_write_gives(tmp_path, umask):
         os.umask(previous)
     mode = stat.S_IMODE((tmp_path / "view.html").stat().st_mode)
     assert mode == stat.S_IMODE((tmp_path / "plain.txt").stat().st_mode) == 0o666 & ~umask
+
+
+def test_an_atomic_write_inside_an_atomic_write_uses_one_temporary(tmp_path):
+    # A run folder's figure: write_run_folder's atomic write around the figure's own save.
+    seen = []
+
+    def inner(tmp):
+        seen.extend(f.name for f in tmp_path.iterdir())
+        tmp.write_text("figure")
+
+    atomic_write(tmp_path / "drift.png", lambda tmp: atomic_write(tmp, inner))
+    assert len(seen) == 1 and seen[0].count(".partial") == 1, seen
+    assert sorted(f.name for f in tmp_path.iterdir()) == ["drift.png"]
+
+
+def test_run_folder_figures_are_written_through_one_temporary_each(tmp_path, monkeypatch):
+    from tumble import _atomic
+
+    temporaries = []
+    original = _atomic.tempfile.mkstemp
+
+    def counting(*args, **kwargs):
+        handle, name = original(*args, **kwargs)
+        temporaries.append(Path(name).name)
+        return handle, name
+
+    monkeypatch.setattr(_atomic.tempfile, "mkstemp", counting)
+    result = scenarios.get("projectile").run()
+    write_run_folder(result, tmp_path / "run")
+    assert all(name.count(".partial") == 1 and not name.startswith("..") for name in temporaries)
+    assert (
+        len(temporaries)
+        == len(json.loads((tmp_path / "run/summary.json").read_text())["files"]) + 1
+    )
+
+
+def test_a_reused_folder_loses_the_partials_a_killed_run_left(tmp_path):
+    out = tmp_path / "run"
+    out.mkdir()
+    stale = [out / ".drift.k2j1x.partial.png", out / ".data.abc.partial.nc"]
+    for path in stale:
+        path.write_bytes(b"")
+    (out / ".hidden-but-mine").write_text("keep")
+    write_run_folder(scenarios.get("projectile").run(), out, force=True)
+    assert not any(path.exists() for path in stale)
+    assert (out / ".hidden-but-mine").read_text() == "keep"
+
+
+def test_a_folder_holding_only_stale_partials_counts_as_empty(tmp_path):
+    (tmp_path / ".trajectory.x1.partial.png").write_bytes(b"")
+    write_run_folder(scenarios.get("projectile").run(), tmp_path)  # no force needed
+    assert (tmp_path / "summary.json").is_file()
+
+
+@pytest.mark.parametrize("where", ["file", "proc"])
+def test_a_run_folder_that_cannot_be_created_is_refused_by_name(tmp_path, where):
+    if where == "file":
+        (tmp_path / "plain").write_text("x")
+        out = tmp_path / "plain" / "run"
+    else:
+        out = Path("/proc/tumble-run")
+    with pytest.raises(ValueError, match=r"out='.*run' cannot be created"):
+        write_run_folder(scenarios.get("projectile").run(), out)
+
+
+def test_atomic_write_into_a_missing_folder_is_refused_with_the_path(tmp_path):
+    target = tmp_path / "missing" / "box.stl"
+    with pytest.raises(ValueError, match=r"cannot write '.*box.stl'.*folder must exist"):
+        atomic_write(target, lambda tmp: tmp.write_text("x"))

@@ -4,9 +4,15 @@ from __future__ import annotations
 
 import os
 import tempfile
-from collections.abc import Callable
+import threading
+from collections.abc import Callable, Iterator
 from os import PathLike
 from pathlib import Path
+
+PARTIAL = ".partial"
+"""Marks a temporary file: ``.NAME.XXXX.partial.SUFFIX``."""
+
+_writing = threading.local()  # the temporary files this thread's atomic_write calls are filling
 
 
 def atomic_write(path: str | PathLike[str], writer: Callable[[Path], object]) -> Path:
@@ -17,6 +23,9 @@ def atomic_write(path: str | PathLike[str], writer: Callable[[Path], object]) ->
     matplotlib read the format from it — and is removed if ``writer`` raises. ``os.replace``
     is atomic on POSIX: readers see the old file or the new one, never half of one.
 
+    One file gets one temporary: a ``writer`` that itself writes atomically to the ``tmp`` it
+    was given (a figure's ``save``) writes straight into it.
+
     The file gets the mode an ordinary ``open(path, "w")`` would give it, ``0o666`` less the
     process umask (``mkstemp`` makes its temporary ``0o600``, which would keep colleagues and
     web servers from reading a run folder).
@@ -25,20 +34,50 @@ def atomic_write(path: str | PathLike[str], writer: Callable[[Path], object]) ->
     -------
     Path
         ``path``.
+
+    Raises
+    ------
+    ValueError
+        If the folder of ``path`` does not exist or cannot be written.
     """
     path = Path(path)
-    handle, name = tempfile.mkstemp(
-        dir=path.parent, prefix=f".{path.stem}.", suffix=f".partial{path.suffix}"
-    )
+    active: set[Path] = _active()
+    if path in active:
+        writer(path)  # already the temporary of an outer atomic_write
+        return path
+    try:
+        handle, name = tempfile.mkstemp(
+            dir=path.parent, prefix=f".{path.stem}.", suffix=f"{PARTIAL}{path.suffix}"
+        )
+    except OSError as error:
+        raise ValueError(
+            f"cannot write {str(path)!r}: {error.strerror or error} (its folder must exist and "
+            "be writable)"
+        ) from None
     os.close(handle)
     tmp = Path(name)
+    active.add(tmp)
     try:
         writer(tmp)
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     finally:
+        active.discard(tmp)
         tmp.unlink(missing_ok=True)
     return path
+
+
+def stale_partials(folder: Path) -> Iterator[Path]:
+    """The temporary files that a killed writer left in ``folder`` (``.NAME.XXXX.partial.*``)."""
+    for entry in folder.iterdir():
+        if entry.name.startswith(".") and PARTIAL + "." in entry.name + "." and entry.is_file():
+            yield entry
+
+
+def _active() -> set[Path]:
+    if not hasattr(_writing, "files"):
+        _writing.files = set()
+    return _writing.files
 
 
 def _umask() -> int:

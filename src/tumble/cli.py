@@ -35,6 +35,22 @@ app = typer.Typer(
 console = Console()
 errors = Console(stderr=True)
 
+
+@app.callback()
+def _interruptible() -> None:
+    # SIGTERM (kill, a job scheduler, a closed container) ends a run as Ctrl-C does: the files
+    # being written are removed, and the command exits 130.
+    import signal
+
+    def interrupt(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    try:
+        signal.signal(signal.SIGTERM, interrupt)
+    except ValueError:  # not the main thread (an embedding application): leave it alone
+        pass
+
+
 Out = Annotated[Path | None, typer.Option(help="Run folder (default: runs/<name>).")]
 Force = Annotated[bool, typer.Option(help="Overwrite files in an existing folder.")]
 

@@ -38,7 +38,7 @@ from typing import Any
 import numpy as np
 
 from tumble import _checks
-from tumble._atomic import atomic_write
+from tumble._atomic import atomic_write, stale_partials
 from tumble._version import __version__
 
 log = logging.getLogger(__name__)
@@ -141,16 +141,29 @@ def write_json(path: str | Path, data: dict) -> Path:
 
 
 def prepare_folder(out: str | Path, *, force: bool = False) -> Path:
-    """Create the run folder ``out``; refuse a non-empty one unless ``force``."""
+    """Create the run folder ``out``; refuse a non-empty one unless ``force``.
+
+    Temporary files that an interrupted run left behind (``.NAME.XXXX.partial.SUFFIX``) are
+    removed first: they are never a run's files.
+    """
     out = Path(out)
     if out.exists() and not out.is_dir():
         raise ValueError(f"out={str(out)!r} exists and is not a folder")
+    if out.is_dir():
+        for stale in stale_partials(out):
+            stale.unlink(missing_ok=True)
     if out.is_dir() and any(out.iterdir()) and not force:
         raise ValueError(
             f"out={str(out)!r} already holds files; choose another folder or pass force=True "
             "(--force on the command line) to overwrite them"
         )
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise ValueError(
+            f"out={str(out)!r} cannot be created: {error.strerror or error}; choose a folder "
+            "under one you can write to"
+        ) from None
     return out
 
 
