@@ -307,3 +307,14 @@ def test_out_under_a_regular_file_exits_2_naming_it(tmp_path):
     result = runner.invoke(app, ["run", "projectile", "--out", str(out)])
     assert result.exit_code == 2
     assert "cannot be created" in result.output and "Traceback" not in result.output
+
+
+def test_view_of_a_damaged_run_exits_2_in_one_line(tmp_path):
+    runner.invoke(app, ["run", "projectile", "--out", str(tmp_path)])
+    raw = bytearray((tmp_path / "data.nc").read_bytes())
+    header = raw.find(b"OHDR", 200)
+    raw[header : header + 40] = b"\xab" * 40
+    (tmp_path / "data.nc").write_bytes(raw)
+    result = runner.invoke(app, ["view", str(tmp_path), "--no-open"])
+    assert result.exit_code == 2
+    assert "damaged" in result.output and "Traceback" not in result.output

@@ -100,12 +100,38 @@ def test_a_crash_while_writing_data_nc_leaves_no_partial_netcdf(tmp_path, monkey
 def test_load_names_what_is_missing(tmp_path):
     with pytest.raises(ValueError, match="summary.json is missing"):
         io.load(tmp_path)
-    (tmp_path / "summary.json").write_text("{}")
+    (tmp_path / "summary.json").write_text('{"files": ["data.nc"]}')
     with pytest.raises(ValueError, match="data.nc is missing"):
         io.load(tmp_path)
     (tmp_path / "data.nc").write_bytes(b"not netcdf")
     with pytest.raises(ValueError, match="could not be read"):
         io.load(tmp_path / "data.nc")
+
+
+def test_load_refuses_a_folder_missing_a_file_its_summary_lists(tmp_path):
+    io.write_run_folder(scenarios.get("projectile").run(), tmp_path)
+    (tmp_path / "trajectory.png").unlink()
+    with pytest.raises(ValueError, match=r"lists \['trajectory.png'\], which are not there"):
+        io.load(tmp_path)
+
+
+@pytest.mark.parametrize("text", ["{}", "[1, 2]", '{"files": "data.nc"}', '{"files": ["../x"]}'])
+def test_load_refuses_a_summary_that_is_not_a_run_summary(tmp_path, text):
+    io.write_run_folder(scenarios.get("projectile").run(), tmp_path)
+    (tmp_path / "summary.json").write_text(text)
+    with pytest.raises(ValueError, match="not a tumble run summary"):
+        io.load(tmp_path)
+
+
+def test_load_of_a_damaged_data_nc_says_so_without_the_hdf5_error_class(tmp_path):
+    # A bad object header: h5py raises KeyError deep inside xarray.
+    io.write_run_folder(scenarios.get("projectile").run(), tmp_path)
+    raw = bytearray((tmp_path / "data.nc").read_bytes())
+    header = raw.find(b"OHDR", 200)
+    raw[header : header + 40] = b"\xab" * 40
+    (tmp_path / "data.nc").write_bytes(raw)
+    with pytest.raises(ValueError, match="data.nc could not be read.*damaged"):
+        io.load(tmp_path)
 
 
 def test_dataset_needs_a_name_when_there_are_several(tmp_path):

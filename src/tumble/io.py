@@ -323,7 +323,8 @@ def load(path: str | Path) -> Run:
     Raises
     ------
     ValueError
-        If the folder or its ``summary.json`` / ``data.nc`` is missing or unreadable.
+        If the folder or its ``summary.json`` / ``data.nc`` is missing or unreadable, or a file
+        that ``summary.json`` lists is not in the folder.
     """
     import xarray as xr
 
@@ -334,10 +335,34 @@ def load(path: str | Path) -> Run:
     for name in (SUMMARY_FILE, DATA_FILE):
         if not (folder / name).is_file():
             raise ValueError(f"path={str(path)!r} is not a complete run folder: {name} is missing")
+    summary = _read_summary(folder)
+    missing = [name for name in summary["files"] if not (folder / name).is_file()]
+    if missing:
+        raise ValueError(
+            f"path={str(path)!r} is not a complete run folder: {SUMMARY_FILE} lists {missing}, "
+            "which are not there (moved, deleted, or the folder was copied in part)"
+        )
     try:
-        summary = json.loads((folder / SUMMARY_FILE).read_text(encoding="utf-8"))
         with xr.open_datatree(folder / DATA_FILE, engine="h5netcdf") as tree:
             data = tree.load().copy()
-    except (OSError, ValueError) as error:
-        raise ValueError(f"path={str(path)!r} could not be read: {error}") from error
+    except Exception as error:  # noqa: BLE001 - h5py and netCDF raise KeyError, OSError, ...
+        raise ValueError(
+            f"path={str(path)!r}: {DATA_FILE} could not be read ({error}); it is damaged or not "
+            "a netCDF-4 file written by tumble: run the scenario again"
+        ) from None
     return Run(folder, summary, data)
+
+
+def _read_summary(folder: Path) -> dict:
+    """``summary.json``, checked to be an object whose ``files`` is a list of file names."""
+    where = f"{str(folder / SUMMARY_FILE)!r}"
+    try:
+        summary = json.loads((folder / SUMMARY_FILE).read_text(encoding="utf-8"))
+    except (OSError, ValueError) as error:
+        raise ValueError(f"{where} could not be read: {error}") from None
+    files = summary.get("files") if isinstance(summary, dict) else None
+    if not isinstance(files, list) or not all(
+        isinstance(name, str) and Path(name).name == name for name in files
+    ):
+        raise ValueError(f"{where} is not a tumble run summary: it needs 'files', a list of names")
+    return summary
