@@ -318,3 +318,9 @@ def test_view_of_a_damaged_run_exits_2_in_one_line(tmp_path):
     result = runner.invoke(app, ["view", str(tmp_path), "--no-open"])
     assert result.exit_code == 2
     assert "damaged" in result.output and "Traceback" not in result.output
+
+
+def test_a_step_too_small_for_memory_exits_2_with_the_size(tmp_path):
+    result = runner.invoke(app, ["run", "t-handle", "--h", "1e-9", "--out", str(tmp_path / "r")])
+    assert result.exit_code == 2
+    assert "1e+11 samples" in result.output and "Traceback" not in result.output

@@ -182,3 +182,32 @@ def test_record_times_are_every_kth_grid_time_and_the_end(n, every, block):
     if expected[-1] != 1.0:
         expected.append(1.0)
     np.testing.assert_array_equal(out.t, expected)
+
+
+def test_a_record_too_large_for_memory_is_refused_before_allocating():
+    import tumble
+
+    body = tumble.RigidBody(1.0, np.diag([1.0, 2.0, 3.0]))
+    with pytest.raises(
+        ValueError, match=r"record 1e\+10 samples of \d+ bytes \(1.\d+ TiB\).*record_every >= "
+    ):
+        tumble.simulate(body, 1e4, h=1e-6, omega0=[1, 0, 0])
+    with pytest.raises(ValueError, match="would never finish: raise h"):
+        tumble.simulate(body, 1.0, h=1e-300, omega0=[1, 0, 0])
+
+
+def test_the_suggested_record_every_makes_the_run_fit(monkeypatch):
+    import re
+
+    import tumble
+    from tumble.ode import driver
+
+    monkeypatch.setattr(driver, "_memory", lambda: 1e6)  # a 1 MB machine: 0.5 MB for records
+    body = tumble.RigidBody(1.0, np.diag([1.0, 2.0, 3.0]))
+    with pytest.raises(ValueError, match="record_every >= ") as refused:
+        tumble.simulate(body, 10.0, h=1e-3, omega0=[1, 0, 0])
+    every = int(re.search(r"record_every >= (\d+)", str(refused.value)).group(1))
+    run = tumble.simulate(body, 10.0, h=1e-3, omega0=[1, 0, 0], record_every=every)
+    assert run.status == 0 and run.t[-1] == 10.0
+    with pytest.raises(ValueError, match="record_every >= "):
+        tumble.simulate(body, 10.0, h=1e-3, omega0=[1, 0, 0], record_every=every // 2)

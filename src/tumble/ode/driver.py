@@ -63,6 +63,7 @@ References
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import IntEnum
@@ -84,6 +85,10 @@ PROGRESS_EVERY = 256
 
 PROGRESS_BLOCKS = 50
 """A compiled run with a progress bar marches in about this many blocks."""
+
+RECORD_MEMORY_SHARE = 0.5
+"""A fixed-step run is refused up front when its record would need more than this share of the
+machine's memory."""
 
 
 class Status(IntEnum):
@@ -432,6 +437,57 @@ def _blocks(run: _Run, t1: float, h: float) -> bool:
     return True
 
 
+def check_record_size(
+    span: float, h: float, every: int, max_steps: float, sample: tuple, n_jumps: int = 0
+) -> None:
+    """Refuse a fixed-step run whose record would not fit in memory, before it starts.
+
+    ``sample`` is one recorded state (:meth:`Stepper.record`); the record holds about
+    ``min(span / h, max_steps) / every + 1`` of them, plus one per jump, and their times.
+
+    Raises
+    ------
+    ValueError
+        Naming ``h``, the number of samples, the memory they need and what allows; the remedy
+        is ``record_every``, a larger ``h`` or a shorter run.
+    """
+    with np.errstate(over="ignore"):
+        steps = min(span / h, max_steps)
+    samples = steps / every + 1 + n_jumps
+    per_sample = 8 + sum(np.asarray(part).nbytes for part in sample)
+    need, allowed = samples * per_sample, RECORD_MEMORY_SHARE * _memory()
+    if need <= allowed:
+        return
+    message = (
+        f"h={h!r} over {span!r} s would record {samples:.3g} samples of {per_sample} bytes "
+        f"({_bytes(need)}), more than the {_bytes(allowed)} (half of this machine's memory) "
+        "that a record may take"
+    )
+    if steps > 1e13:  # a week of steps at 0.1 µs each: the step, not the record, is wrong
+        raise ValueError(f"{message}; {steps:.3g} steps would never finish: raise h")
+    smallest = math.ceil(steps * per_sample / allowed)
+    raise ValueError(
+        f"{message}; record fewer samples with record_every >= {smallest}, or raise h, or "
+        "shorten the run"
+    )
+
+
+def _memory() -> float:
+    """This machine's physical memory in bytes (16 GiB if the system does not say)."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 16.0 * 2**30
+
+
+def _bytes(count: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if count < 1024 or unit == "PiB":
+            return f"{count:.3g} {unit}"
+        count /= 1024
+    raise AssertionError  # pragma: no cover - the loop always returns
+
+
 def _segments(t0: float, t1: float, jumps: Sequence[Jump]) -> list[tuple[float, list]]:
     """``[(end, jumps applied at the end), ...]``: the span cut at the jumps' times."""
     times = sorted({time for time, _ in jumps if t0 <= time <= t1} | {t1})
@@ -501,6 +557,8 @@ def march(
     step = float(h)
     limit = math.inf if max_steps is None else max_steps
     run = _Run(stepper, t0, state, list(events), record_every, limit, dense_output, progress)
+    if control is None:
+        check_record_size(t1 - t0, step, record_every, limit, run.samples[0], len(jumps))
     compiled = stepper.blocks and control is None and not events and not dense_output
     going = True
     for end, applied in _segments(t0, t1, jumps):
