@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from tumble.rigid import Impulse, RigidBody, simulate
+from tumble.rigid import METHODS, Impulse, RigidBody, simulate
 
 BODY = RigidBody(1.0, [1.0, 2.0, 2.5])
 
@@ -124,3 +124,19 @@ def test_io_load_of_none_names_the_path():
 
     with pytest.raises(ValueError, match=r"^path=None is not allowed"):
         io.load(None)
+
+
+@pytest.mark.parametrize("method", [name for name, spec in METHODS.items() if spec.adaptive])
+def test_an_adaptive_run_whose_load_turns_nan_says_so_not_minimum_step(method):
+    from tumble.rigid.forces import Force
+
+    def force(t, state):
+        return np.array([np.nan, 0.0, 0.0]) if t > 0.5 else np.array([0.0, 1.0, 0.0])
+
+    body = RigidBody(1.0, np.diag([1.0, 2.0, 3.0]))
+    run = simulate(
+        body, 2.0, method=method, omega0=[1, 0.1, 0], forces=[Force(force, point=[0.1, 0, 0])]
+    )
+    assert run.status == -1
+    assert run.message.startswith("the state became non-finite (nan or inf)"), run.message
+    assert "a load" in run.message and run.t[-1] == pytest.approx(0.5)

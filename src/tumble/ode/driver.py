@@ -399,10 +399,7 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
         if not accepted:
             run.n_rejected += 1
             if h < h_min:
-                cause = (
-                    "" if math.isfinite(norm) else " (the solution became non-finite: nan or inf)"
-                )
-                run.fail(f"step size fell below the minimum {h_min:.3g} at t={t_old!r}{cause}")
+                run.fail(_minimum_step_message(t_old, h_min, math.isfinite(norm)))
                 return False, h
             continue
         if not stepper.finite(new):
@@ -411,6 +408,17 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
         if run.accept(t_old, old, t_new, new):
             return False, h
     return True, h
+
+
+def _minimum_step_message(t: float, h_min: float, finite: bool) -> str:
+    """Why an adaptive run stopped at the minimum step: accuracy, or a non-finite state."""
+    if finite:
+        return f"step size fell below the minimum {h_min:.3g} at t={t!r}"
+    return (
+        f"the state became non-finite (nan or inf) in every step tried from t={t!r}, down to "
+        f"the minimum step {h_min:.3g}: something the run evaluates (a load, the right-hand "
+        "side) is not finite just after that time; the run ends with the last finite state"
+    )
 
 
 def _blocks(run: _Run, t1: float, h: float) -> bool:
