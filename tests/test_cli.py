@@ -324,3 +324,16 @@ def test_a_step_too_small_for_memory_exits_2_with_the_size(tmp_path):
     result = runner.invoke(app, ["run", "t-handle", "--h", "1e-9", "--out", str(tmp_path / "r")])
     assert result.exit_code == 2
     assert "1e+11 samples" in result.output and "Traceback" not in result.output
+
+
+def test_library_messages_become_the_status_line_while_a_command_runs():
+    import logging
+
+    from tumble.cli import _status_from_log
+
+    seen = []
+    with _status_from_log(seen.append):
+        logging.getLogger("tumble.rigid").info("preparing the compiled %s", "loop")
+        logging.getLogger("tumble").debug("too fine to show")
+    logging.getLogger("tumble").info("after the command")
+    assert seen == ["preparing the compiled loop"]

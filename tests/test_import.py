@@ -101,3 +101,22 @@ def test_version_is_the_installed_metadata():
 def test_an_unknown_name_raises_attribute_error():
     with pytest.raises(AttributeError, match="no attribute 'simulat'"):
         tumble.simulat  # noqa: B018
+
+
+def test_a_kernels_first_call_is_announced_once(caplog):
+    import logging
+
+    from numba import njit
+
+    from tumble._progress import announce_compilation
+
+    @njit(cache=False)
+    def kernel(x):
+        return x + 1
+
+    with caplog.at_level(logging.INFO, logger="tumble"):
+        announce_compilation(kernel, "the test kernel")
+        kernel(1.0)
+        announce_compilation(kernel, "the test kernel")
+    messages = [r.getMessage() for r in caplog.records if r.name == "tumble"]
+    assert len(messages) == 1 and "the test kernel" in messages[0] and "10 s" in messages[0]

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import inspect
 import json
+import logging
 import warnings
 import webbrowser
 from collections.abc import Callable, Iterator
@@ -85,7 +86,36 @@ def _progress(title: str) -> Iterator[Callable[[str], None]]:
     )
     with progress:
         task = progress.add_task(title, total=None)
-        yield lambda stage: progress.update(task, description=f"{title}: {stage}")
+
+        def note(stage: str) -> None:
+            progress.update(task, description=f"{title}: {stage}")
+
+        with _status_from_log(note):
+            yield note
+
+
+class _StatusHandler(logging.Handler):
+    """Shows the library's INFO messages (a kernel compiling) as the status line."""
+
+    def __init__(self, note: Callable[[str], None]):
+        super().__init__(logging.INFO)
+        self.note = note
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.note(record.getMessage())
+
+
+@contextmanager
+def _status_from_log(note: Callable[[str], None]) -> Iterator[None]:
+    library = logging.getLogger("tumble")
+    handler, level = _StatusHandler(note), library.level
+    library.addHandler(handler)
+    library.setLevel(min(level or logging.WARNING, logging.INFO))
+    try:
+        yield
+    finally:
+        library.removeHandler(handler)
+        library.setLevel(level)
 
 
 def _write(

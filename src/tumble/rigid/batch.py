@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble import _checks, so3
+from tumble._progress import announce_compilation
 from tumble.ode.control import fixed_step_count
 from tumble.ode.driver import Block, Grid, Status, Stepper, march, non_finite_message
 from tumble.rigid import geometric, initial
@@ -516,6 +517,7 @@ class BatchStepper(Stepper):
             Z, RN = np.array(state[1], dtype=float), np.array(state[0], dtype=float)
         else:
             Z, RN = self.chart.pack(*state)
+        announce_compilation(self.batch, f"the batch loop of {self.method.name}")
         self.batch(self.problem, grid, Z, RN, every, records, self.counts, self.failed,
                    self.causes)  # fmt: skip
         q = records.q if self._quat else np.empty((n_bodies, size, 0))

@@ -21,6 +21,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from tumble._progress import announce_compilation
 from tumble.ode.driver import Block, Grid, Stepper, non_finite_message
 from tumble.ode.stepper import rk_step
 from tumble.rigid import geometric
@@ -177,6 +178,7 @@ class CompiledStepper(RigidStepper):
     ) -> Block:
         records = _records((k1 - k0) // every + 1)
         z, Rn = self.chart.pack(*state)
+        announce_compilation(self.loop, f"the {self.chart.name} chart's loop")
         count, failed, _ = self.loop(self.problem, grid, z, Rn, k0, k1, every, step0, records)
         q = records.q[:count] if self._quat else np.empty((count, 0))
         return Block(
@@ -213,6 +215,7 @@ class CompiledSplitStepper(SplitStepper):
 
         records = _records((k1 - k0) // every + 1)
         Rp, Y = np.array(state[0], dtype=float), np.array(state[1], dtype=float)
+        announce_compilation(self.loop, f"the {self.method.flow} flow's loop")
         count, failed, cause = self.loop(self.problem, grid, Y, Rp, k0, k1, every, step0,
                                          records)  # fmt: skip
         self.unconverged = failed >= 0 and cause == UNCONVERGED

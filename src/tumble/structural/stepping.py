@@ -35,6 +35,7 @@ import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
+from tumble._progress import announce_compilation
 from tumble.ode.driver import Block, Grid, Stepper
 from tumble.structural.factorization import BandedCholesky, factorize
 from tumble.structural.kernels import all_finite, run_steps
@@ -185,6 +186,7 @@ class CompiledStepper(Stepper):
 
     def _run(self, state: State, k0: int, k1: int, steps: NDArray[np.int64], xs, ys):
         vectors = (state.x, state.y, state.q, state.g)
+        announce_compilation(run_steps, "the structural time loop")
         return run_steps(k0, k1, steps, 0, self.coefficients, vectors, self.frame, self.factor,
                          self.mass, self.damping, self.work, xs, ys)  # fmt: skip
 
