@@ -44,7 +44,7 @@ def test_data_nc_round_trips_with_its_attributes(tmp_path):
     result = _t_handle()
     io.write_run_folder(result, tmp_path, animation=False)
     run = io.load(tmp_path)
-    assert run.groups == ["spin1", "mesh"]
+    assert run.groups == ["", "mesh"]  # one run: its data at the root
     assert run.attrs["scenario"] == "t-handle" and run.attrs["method"] == "rkmk4"
     assert run.attrs["h"] == 0.01 and run.attrs["t_end"] == 2.0
     body = result.data["body"]
@@ -52,11 +52,11 @@ def test_data_nc_round_trips_with_its_attributes(tmp_path):
     np.testing.assert_array_equal(run.attrs["inertia"], np.ravel(body.inertia))
     assert run.attrs["tumble_version"] == tumble.__version__
     original = result.data["trajectories"][0]
-    back = Trajectory.from_xarray(run.dataset("spin1"))
+    back = Trajectory.from_xarray(run.dataset())
     np.testing.assert_array_equal(back.t, original.t)
     np.testing.assert_array_equal(back.R, original.R)
     np.testing.assert_array_equal(back.L_world, original.L_world)
-    assert run.dataset("spin1")["energy"].attrs["units"] == "J"
+    assert run.dataset("")["energy"].attrs["units"] == "J"
     assert run.summary == json.loads(json.dumps({**result.summary, "files": run.summary["files"]}))
 
 
@@ -135,7 +135,8 @@ def test_load_of_a_damaged_data_nc_says_so_without_the_hdf5_error_class(tmp_path
 
 
 def test_dataset_needs_a_name_when_there_are_several(tmp_path):
-    io.write_run_folder(_t_handle(), tmp_path, animation=False)
+    result = scenarios.get("t-handle").run(t_end=1.0, spins=[(1.0, 0.05, 0.0), (0.0, 1.0, 0.05)])
+    io.write_run_folder(result, tmp_path, animation=False)
     run = io.load(tmp_path)
     with pytest.raises(ValueError, match=r"ambiguous.*spin1"):
         run.dataset()
@@ -261,3 +262,20 @@ def test_atomic_write_into_a_missing_folder_is_refused_with_the_path(tmp_path):
     target = tmp_path / "missing" / "box.stl"
     with pytest.raises(ValueError, match=r"cannot write '.*box.stl'.*folder must exist"):
         atomic_write(target, lambda tmp: tmp.write_text("x"))
+
+
+def test_open_dataset_on_a_single_run_shows_its_data_at_the_root(tmp_path):
+    io.write_run_folder(_t_handle(), tmp_path, animation=False)
+    with xr.open_dataset(tmp_path / "data.nc", engine="h5netcdf") as data:
+        assert {"R", "omega_body", "energy"} <= set(data.data_vars)
+        assert data.sizes["time"] == 201 and data.attrs["scenario"] == "t-handle"
+
+
+def test_a_multi_run_root_lists_its_groups_and_how_to_open_them(tmp_path):
+    result = scenarios.get("t-handle").run(t_end=1.0, spins=[(1.0, 0.05, 0.0), (0.0, 1.0, 0.05)])
+    io.write_run_folder(result, tmp_path, animation=False)
+    with xr.open_dataset(tmp_path / "data.nc", engine="h5netcdf") as root:
+        assert root.attrs["groups"] == "spin1, spin2, mesh"
+        assert "open_datatree" in root.attrs["comment"]
+    with xr.open_dataset(tmp_path / "data.nc", engine="h5netcdf", group="spin2") as spin:
+        assert spin.sizes["time"] == 101

@@ -191,7 +191,9 @@ def netcdf_attrs(attrs: Mapping[str, Any]) -> dict[str, Any]:
 def write_dataset(path: str | Path, datasets: Mapping[str, Any], attrs: Mapping[str, Any]) -> Path:
     """Write ``datasets`` as one netCDF-4 file, one group each, ``attrs`` on the root group.
 
-    A single dataset named ``""`` becomes the root group itself. The file is written atomically.
+    A dataset named ``""`` becomes the root group itself, what ``xarray.open_dataset`` shows.
+    Without one, the root's attribute ``groups`` lists the groups, and ``comment`` says how to
+    open them all. The file is written atomically.
     """
     import xarray as xr
 
@@ -200,7 +202,15 @@ def write_dataset(path: str | Path, datasets: Mapping[str, Any], attrs: Mapping[
         for name, ds in datasets.items()
     }
     root = groups.pop("/", xr.Dataset())
-    root = root.assign_attrs(netcdf_attrs({**attrs, "tumble_version": __version__}))
+    attrs = {**attrs, "tumble_version": __version__}
+    if not root.data_vars and groups:
+        attrs["groups"] = ", ".join(name.lstrip("/") for name in groups)
+        attrs["comment"] = (
+            "one group per run: xarray.open_datatree(path) opens them all, "
+            "xarray.open_dataset(path, group=name) one; tumble.io.load(folder) reads the "
+            "run folder"
+        )
+    root = root.assign_attrs(netcdf_attrs(attrs))
     tree = xr.DataTree.from_dict({"/": root, **groups})
     return atomic_write(path, lambda tmp: tree.to_netcdf(tmp, engine="h5netcdf"))
 
@@ -306,12 +316,17 @@ class Run:
         return [node.path.lstrip("/") for node in self.data.subtree if node.data_vars]
 
     def dataset(self, name: str | None = None):
-        """The ``xarray.Dataset`` of one run (the only one when ``name`` is None)."""
+        """The ``xarray.Dataset`` of one run (the only one when ``name`` is None).
+
+        ``""`` is the root group: a single-run scenario's data. The body's ``mesh`` group is
+        not a run, so it is never chosen for ``name=None``.
+        """
         groups = self.groups
         if name is None:
-            if len(groups) != 1:
+            runs = [group for group in groups if group != "mesh"]
+            if len(runs) != 1:
                 raise ValueError(f"name=None is ambiguous: this run has the groups {groups}")
-            name = groups[0]
+            name = runs[0]
         if name not in groups:
             raise ValueError(f"name={name!r} is not a run in {self.path}; choose one of {groups}")
         return self.data[f"/{name}" if name else "/"].to_dataset()

@@ -189,7 +189,7 @@ def test_result_carries_figures_data_and_animations():
         "snapshots.png",
     ]
     assert [name for name, _ in result.animations] == ["animation.gif", "view.html"]
-    assert sorted(result.datasets) == ["mesh", "rkmk4"]
+    assert sorted(result.datasets) == ["", "mesh"]  # one run: data.nc's root group
     assert result.attrs["mass"] == 2.0 and len(result.attrs["inertia"]) == 9
     assert result.attrs["method"] == "rkmk4" and result.attrs["h"] == 0.1
     json.dumps(result.summary)  # written to summary.json

@@ -94,13 +94,19 @@ def showcase(runs: Mapping[str, Any]) -> str:
 def rigid_datasets(runs: Mapping[str, Any], mesh=None, shown: str | None = None) -> dict[str, Any]:
     """One ``xarray.Dataset`` per trajectory, keyed like ``runs`` (the groups of ``data.nc``).
 
+    A single run is keyed ``""``: ``data.nc``'s root group, what ``xr.open_dataset`` shows.
     With ``mesh``, a group ``mesh`` holds its ``vertices`` (m, body frame) and ``faces``, and
-    names the run the animation shows (attribute ``shows``), so ``tumble view`` can draw it
-    again from ``data.nc`` alone.
+    names the run the animation shows (attribute ``shows``; ``""`` for the root), so
+    ``tumble view`` can draw it again from ``data.nc`` alone.
     """
-    datasets = {name: run.to_xarray() for name, run in runs.items()}
+    if len(runs) == 1:
+        datasets = {"": next(iter(runs.values())).to_xarray()}
+        shown = ""
+    else:
+        datasets = {name: run.to_xarray() for name, run in runs.items()}
+        shown = shown or showcase(runs)
     if mesh is not None:
-        datasets["mesh"] = mesh_dataset(mesh, shows=shown or showcase(runs))
+        datasets["mesh"] = mesh_dataset(mesh, shows=shown)
     return datasets
 
 
