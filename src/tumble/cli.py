@@ -368,7 +368,7 @@ def _viewer(run_dir: Path) -> Path:
     mesh = trimesh.Trimesh(mesh_data["vertices"].values, mesh_data["faces"].values, process=False)
     shows = mesh_data.attrs["shows"]
     trajectory = Trajectory.from_xarray(run.dataset(shows))
-    title = f"{run.attrs.get('scenario')} — {shows}, {trajectory.method}"
+    title = f"{run.attrs.get('scenario')} — {f'{shows}, ' if shows else ''}{trajectory.method}"
     atomic_write(page, lambda tmp: html_viewer(trajectory, mesh, tmp, title=title))
     return page
 

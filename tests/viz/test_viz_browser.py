@@ -140,3 +140,40 @@ def test_clicking_the_slider_rail_moves_the_mesh(page, view):
     expected = np.asarray(view[1].frames[active].data[0].x, dtype=float)
     np.testing.assert_allclose(after, expected, rtol=1e-6)
     assert severe_messages(page) == []
+
+
+ENERGY_AXIS_BOXES = f"""
+const div = {PLOT};
+const box = (el) => {{ const r = el.getBoundingClientRect(); return [r.left, r.right]; }};
+const ticks = Array.from(div.querySelectorAll('.yaxislayer-above .ytick text')).map(box);
+const title = div.querySelector('.g-ytitle text');
+return [ticks, title ? box(title) : null, div.getBoundingClientRect().left];
+"""
+
+
+@pytest.mark.parametrize("height", [0.0, 1e4])
+def test_energy_tick_labels_and_title_keep_clear_of_the_edge_and_each_other(
+    browser, tmp_path, height
+):
+    # Energy tick labels are long (4.920394e−5 J; 1.0000001e+5 J for a body high in gravity);
+    # they used to run into the page edge and into the axis title.
+    from selenium.webdriver.support.ui import WebDriverWait
+
+    body = tumble.rigid.RigidBody.from_mass_properties(tumble.mass.t_handle())
+    loads = [tumble.rigid.Gravity()] if height else []
+    run = tumble.rigid.simulate(
+        body, 2.0, h=0.01, x0=(0, 0, height), omega0=(0.0, 5.0, 0.1), forces=loads
+    )
+    path = tmp_path / "view.html"
+    html_viewer(run, meshes.t_handle(16), path, title="T-handle", frames=FRAMES)
+    browser.get(path.as_uri())
+    WebDriverWait(browser, WAIT_S).until(lambda driver: driver.execute_script(DRAWN_SCENE))
+    ticks, title, left = browser.execute_script(ENERGY_AXIS_BOXES)
+    assert ticks and title is not None
+    first_tick = min(start for start, _ in ticks)
+    assert first_tick >= left + 4, f"a tick label starts {first_tick - left:.0f} px from the edge"
+    # a clear gap from the page edge (it was 10-15 px) and from the tick labels
+    assert title[0] >= left + 24, f"the axis title starts {title[0] - left:.0f} px from the edge"
+    assert title[1] + 6 <= first_tick, (
+        f"title ends at {title[1]:.0f}, labels start {first_tick:.0f}"
+    )

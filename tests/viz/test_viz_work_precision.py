@@ -101,7 +101,7 @@ def test_figure_has_two_log_panels_with_units_and_one_line_per_method(points):
         assert "R_exact" in axes.get_ylabel() and "(–)" in axes.get_ylabel()
         assert axes.get_xscale() == axes.get_yscale() == "log"
         assert len(axes.get_lines()) == 3
-    labels = [text.get_text() for text in by_time.get_legend().get_texts()]
+    labels = [text.get_text() for text in figure.legends[0].get_texts()]  # beside the panels
     assert labels == ["rkmk4 (h)", "lie-euler (h)", "rkmk45 (rtol)"]
     assert figure.get_suptitle() == "free body, T = 10 s"
 
@@ -121,3 +121,42 @@ def test_figure_leaves_out_a_diverged_run():
 def test_figure_of_no_points_is_refused():
     with pytest.raises(ValueError, match="points"):
         draw_work_precision([], title="t")
+
+
+def _tick_labels_overlap(figure) -> list[str]:
+    figure.canvas.draw()
+    renderer = figure.canvas.get_renderer()
+    clashes = []
+    for axes in figure.axes:
+        for axis in (axes.xaxis, axes.yaxis):
+            boxes = [
+                (label.get_text(), label.get_window_extent(renderer))
+                for label in axis.get_ticklabels(which="both")
+                if label.get_visible() and label.get_text()
+            ]
+            for k, (text, box) in enumerate(boxes):
+                clashes += [f"{text} / {other}" for other, b in boxes[k + 1 :] if box.overlaps(b)]
+    return clashes
+
+
+@pytest.mark.parametrize("span", [1.5, 3.0, 30.0, 1e4])
+def test_tick_labels_never_overlap_whatever_the_time_span(span):
+    # The time axis of a fast run covers less than a decade; matplotlib's default labelled
+    # each of its minor ticks there, and the labels ran into each other.
+    points = [
+        WorkPrecisionPoint(
+            method, 0.1 / 2**k, 100 * 2**k, 0, 2e-4 * span ** (k / 3), 10.0 ** -(k + i)
+        )
+        for i, method in enumerate(["rkmk4", "rk4-quat", "lie-euler"])
+        for k in range(4)
+    ]
+    assert _tick_labels_overlap(draw_work_precision(points, title="span")) == []
+
+
+def test_every_method_gets_its_own_colour():
+    from tumble.rigid import METHODS
+
+    points = [WorkPrecisionPoint(name, 0.1, 100, 0, 1e-4, 1e-6) for name in METHODS]
+    figure = draw_work_precision(points, title="every method")
+    colours = {tuple(np.atleast_1d(line.get_color())) for line in figure.axes[0].lines}
+    assert len(colours) == len(METHODS)

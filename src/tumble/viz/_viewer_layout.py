@@ -113,7 +113,7 @@ def apply_layout(fig, title: str, times, world: np.ndarray, arrows, energy_range
     fig.update_layout(
         title={"text": html.escape(title).replace("\n", "<br>"), "x": 0.5, "xanchor": "center"},
         height=850 + 20 * title.count("\n"),
-        margin={"l": 60, "r": 30, "t": 60 + 20 * title.count("\n"), "b": 50},
+        margin={"l": 150, "r": 40, "t": 60 + 20 * title.count("\n"), "b": 50, "pad": 4},
         showlegend=False,
         uirevision="tumble",
         scene={
@@ -128,6 +128,8 @@ def apply_layout(fig, title: str, times, world: np.ndarray, arrows, energy_range
             "range": energy_range,
             "domain": [0.0, ENERGY_TOP],
             "exponentformat": "e",
+            "automargin": True,  # long tick labels (4.920394e−5) widen the margin, not the edge
+            "title_standoff": 12,
         },
     )
 
