@@ -80,7 +80,7 @@ def _colours(palette: str, count: int) -> list:
     """``count`` distinct colours of a qualitative matplotlib palette (repeating past its end)."""
     from matplotlib import colormaps
 
-    colours = colormaps[palette].colors
+    colours = colormaps[palette].colors  # type: ignore[attr-defined]  # a ListedColormap
     return [colours[k % len(colours)] for k in range(count)]
 
 
