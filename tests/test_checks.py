@@ -49,6 +49,9 @@ REFUSALS = [
     ("callables", lambda: _checks.callables("events", 42), "events", 42),
     ("callables", lambda: _checks.callables("events", "g"), "events", "g"),
     ("callables", lambda: _checks.callables("events", [print, 3]), "events[1]", 3),
+    ("sample_times", lambda: _checks.sample_times("t_eval", [0, 2, 1], 0, 3), "t_eval", [0, 2, 1]),
+    ("sample_times", lambda: _checks.sample_times("t_eval", [0, 4], 0, 3), "t_eval[1]", 4.0),
+    ("sample_times", lambda: _checks.sample_times("t_eval", [], 0, 3), "t_eval", []),
 ]
 
 
