@@ -390,7 +390,7 @@ class _Run:
             k += 1
         self.next_eval = k
 
-    def extend(self, block: Block) -> None:
+    def extend(self, block: Block | AdaptiveBlock) -> None:
         if len(block.t):
             self.times.append(block.t)
             self.samples.append(block.records)

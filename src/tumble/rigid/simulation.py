@@ -242,7 +242,7 @@ def simulate(
         )  # fmt: skip
     spec = get_method(method)
     t0, t_end = initial.check_times(t0, t_end)
-    h, rtol, atol = initial.check_steps(spec, h, rtol, atol)
+    h, rtol, given_atol = initial.check_steps(spec, h, rtol, atol)
     R, Y = initial.initial_state(body, x0, v0, R0, q0, omega0, L0)
     record_every = _checks.count("record_every", record_every)
     progress = _checks.flag("progress", progress)
@@ -252,8 +252,9 @@ def simulate(
     events = _checks.callables("events", events, remedy="g(t, state) with state a State")
     dense_output = _checks.flag("dense_output", dense_output)
     times = None if t_eval is None else _checks.sample_times("t_eval", t_eval, t0, t_end)
-    if spec.adaptive:
-        atol = initial.tolerances(body, Y, t_end - t0, rtol, atol)
+    tolerance = (
+        initial.tolerances(body, Y, t_end - t0, rtol, given_atol) if spec.adaptive else None
+    )
     kernel_loads = compiled_loads(loads, body.mass)
     plain = not events and times is None and not dense_output
     use_kernel = kernel_loads is not None and plain and (not spec.adaptive or spec.family == "lie")
@@ -268,7 +269,7 @@ def simulate(
     settings = {
         "h": h,
         "rtol": rtol or None,
-        "atol": None if atol is None else atol.tolist(),
+        "atol": None if tolerance is None else tolerance.tolist(),
         "record_every": record_every,
         "compiled": use_kernel,
     }
@@ -276,7 +277,8 @@ def simulate(
     jumps = _jumps(stepper, impulses, t0, t_end)
     control = None
     if spec.adaptive:
-        control = Control(rtol, atol, horizon=t_end - t0)
+        assert tolerance is not None
+        control = Control(rtol, tolerance, horizon=t_end - t0)
         if h is None:
             first = [apply for time, apply in jumps if time == t0]
             Y_first = first[0](state)[1] if first else Y
@@ -303,6 +305,9 @@ def simulate(
     if not out.status.success:
         log.warning("simulate stopped early: %s", out.message)
     R_samples, Y_samples, q_samples = out.records
+    sol = None
+    if out.step_times is not None and out.interpolants is not None:
+        sol = Solution(stepper, out.step_times, out.interpolants)
     with np.errstate(over="ignore", invalid="ignore"):
         V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
     return Trajectory(
@@ -321,9 +326,7 @@ def simulate(
         t_events=[np.array(ts, dtype=float) for ts in out.t_events],
         q_raw=q_samples if spec.family == "quat" else None,
         potential_energy=V,
-        sol=None
-        if out.interpolants is None
-        else Solution(stepper, out.step_times, out.interpolants),  # fmt: skip
+        sol=sol,
     )
 
 

@@ -39,6 +39,7 @@ class BodyStepper(Stepper):
     """What every rigid-body stepper shares: the attitude as R, users' events, impulses."""
 
     _quat = False
+    dynamics: Dynamics
 
     def matrix(self, attitude: np.ndarray) -> np.ndarray:
         """R for the carried attitude."""
