@@ -1,8 +1,8 @@
 """Work–precision: what each rigid-body method's accuracy costs, on a torque-free body.
 
 Each fixed-step method runs with several step counts and the adaptive ones (``rkmk45``,
-``rkmk-dopri5``) with several tolerances; every run is timed and compared at the end with the exact attitude
-(:func:`tumble.exact.free_body_rotation`). The result is a list of
+``rkmk-dopri5``) with several tolerances; every run is timed and compared at the end with the
+exact attitude (:func:`tumble.exact.free_body_rotation`). The result is a list of
 :class:`WorkPrecisionPoint`; :func:`table` makes rows for printing and
 :func:`tumble.viz.work_precision.work_precision_figure` draws them.
 """
