@@ -82,6 +82,10 @@ class Chart:
     field : callable
         ``field(dynamics, correct, R_n) -> f(t, z)``; ``correct`` is False only for the
         uncorrected Lie stages of ``seed-rk4``.
+    first_same_as_last : callable, optional
+        ``(K, z_new) -> f`` at the new state in its own chart from the last stage ``K[-1]``
+        (``f(t + h, z_new)`` in the old chart) of a FSAL tableau; None where the chart
+        cannot reuse it.
     """
 
     name: str
@@ -92,6 +96,7 @@ class Chart:
     advance: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
     read: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
     field: Callable[[Dynamics, bool, np.ndarray], Field]
+    first_same_as_last: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
 
 
 def _identity(attitude: np.ndarray) -> np.ndarray:
@@ -173,6 +178,15 @@ def error_norm(error, size, Y_old, Y_new, rtol, atol):
     return norm
 
 
+def _lie_first_same_as_last(K: np.ndarray, z_new: np.ndarray) -> np.ndarray:
+    """The next step's first stage from this step's last (FSAL, Dormand–Prince).
+
+    ``K[-1]`` is ``(u̇, ẏ)`` at ``z_new`` in this step's chart, ``u̇ = dexp⁻¹_{−u}(ω)``; the
+    next chart starts at ``u = 0``, where ``u̇ = ω = dexp_{−u}(K[-1]_u)``. The vector part
+    is the same."""
+    return np.concatenate([so3.dexp(-z_new[:3]) @ K[-1, :3], K[-1, 3:]])
+
+
 def _frames(shape: tuple[int, ...]) -> np.ndarray:
     """Identity base points for charts that need none, one per leading index."""
     return np.broadcast_to(np.eye(3), (*shape, 3, 3)).copy()
@@ -220,6 +234,7 @@ LIE = Chart(
     advance=lambda z, Rn: (Rn @ so3.exp(z[:3]), z[3:].copy()),
     read=lambda z, Rn: (Rn.copy(), z[..., 3:].copy()),
     field=_lie_field,
+    first_same_as_last=_lie_first_same_as_last,
 )
 
 CHARTS: dict[str, Chart] = {chart.name: chart for chart in (MATRIX, QUAT, LIE)}

@@ -172,6 +172,28 @@ def _lie_advance(z, znew, Rn):
         z[q] = znew[q]
 
 
+@njit(**_INLINE)
+def _lie_first_same_as_last(K, s, znew):
+    """``K[0] ← (dexp_{−u}(K[s−1]_u), K[s−1]_y)``: the next step's first stage, at ``u = 0``
+    in the new chart, from this step's last (as :func:`tumble.rigid.charts`' reference);
+    ``dexp_{−u} v = v − b u×v + c u×(u×v)`` with ``c = (1 − sin θ/θ)/θ²`` (series when
+    small)."""
+    u0, u1, u2 = znew[0], znew[1], znew[2]
+    x = u0 * u0 + u1 * u1 + u2 * u2
+    a, b = _exp_coefficients(x)
+    c = -(_S1 + x * (_S2 + x * (_S3 + x * (_S4 + x * _S5)))) if x < _SERIES2 else (1.0 - a) / x
+    K[0, 0], K[0, 1], K[0, 2] = _rotate(-b, c, u0, u1, u2, K[s - 1, 0], K[s - 1, 1], K[s - 1, 2])
+    for q in range(3, K.shape[1]):
+        K[0, q] = K[s - 1, q]
+    return True
+
+
+@njit(**_INLINE)
+def _no_first_same_as_last(K, s, znew):
+    """Charts that do not reuse the last stage (their loops recompute the first)."""
+    return False
+
+
 @njit(**_JIT)
 def _lie_record(z, Rn, R_out, q_out, Y_out):
     R_out[:, :] = Rn
@@ -355,8 +377,8 @@ def _batch(problem, grid, Z, RN, every, records, counts, failed, causes):
                                                body_records)  # fmt: skip
 
 
-def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, z, Rn, every, step0, max_steps,
-                   records):  # fmt: skip
+def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, fsal, z, Rn, every, step0,
+                   max_steps, records):  # fmt: skip
     """Adaptive steps from ``t`` towards ``t1`` for one chart: the driver's adaptive loop,
     compiled (:func:`tumble.ode.driver.march` with a ``Control``).
 
@@ -366,7 +388,10 @@ def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, z, Rn, every, step
     functions), tries start from the accepted state, and a step below
     :func:`tumble.ode.control.minimum_step` ends the run, as in the driver. ``control`` is
     ``(safety, min_factor, max_factor, order, horizon)`` (``horizon`` 0: none; see
-    :class:`tumble.ode.driver.Control`). Returns at ``t1``, when ``records`` is full
+    :class:`tumble.ode.driver.Control`). With ``fsal`` (a FSAL tableau) an accepted step's
+    last stage becomes the next one's first through the chart's ``FIRST_SAME_AS_LAST``
+    (:attr:`tumble.rigid.charts.Chart.first_same_as_last`); a call starts with a fresh one.
+    Returns at ``t1``, when ``records`` is full
     or after ``max_steps`` accepted steps:
     ``(recorded, t, h_next, accepted, rejected, code, t_failed, norm_finite)`` with ``code`` 0
     (going on), 1 (a non-finite accepted state; the step to ``t_failed``) or 2 (the minimum
@@ -379,14 +404,14 @@ def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, z, Rn, every, step
     K, zs, err, R = np.empty((s, nz)), np.empty(nz), np.empty(nz), np.empty((3, 3))
     capacity = records.t.shape[0]
     count, until_record = 0, every - step0 % every
-    accepted, rejected, after_rejection = 0, 0, False
+    accepted, rejected, after_rejection, have_first = 0, 0, False, False
     while t < t1 and count < capacity and accepted < max_steps:
         h_min = MINIMUM_STEP(t)  # noqa: F821
         planned = max(h, h_min)
         t_new = min(t + planned, t1)
         hk = t_new - t
         START(z, Rn)  # noqa: F821
-        for i in range(s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
+        for i in range(1 if have_first else 0, s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
             for q in range(nz):
                 acc = 0.0
                 for j in range(i):
@@ -416,6 +441,7 @@ def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, z, Rn, every, step
         if t_new == t1 and t + planned > t1:
             h = planned  # shortened to land on t1 (as the driver)
         ADVANCE(z, zs, Rn)  # noqa: F821
+        have_first = fsal and FIRST_SAME_AS_LAST(K, s, zs)  # noqa: F821
         t = t_new
         accepted += 1
         until_record -= 1
@@ -456,7 +482,9 @@ _MINIMUM_STEP = njit(**_INLINE)(control.minimum_step)
 _ERROR_NORM = njit(**_INLINE)(charts.error_norm)
 
 
-def _for_chart(name: str, field, advance, record, start=_no_start) -> CompiledChart:
+def _for_chart(
+    name: str, field, advance, record, start=_no_start, fsal=_no_first_same_as_last
+) -> CompiledChart:
     chart = dict(FIELD=field, ADVANCE=advance, RECORD=record, START=start)
     loop = njit(**_JIT)(_bind(_loop, f"_loop_{name}", **chart))
     batch = njit(parallel=True, **_JIT)(_bind(_batch, f"_batch_{name}", LOOP=loop))
@@ -467,8 +495,9 @@ def _for_chart(name: str, field, advance, record, start=_no_start) -> CompiledCh
             NORM=_ERROR_NORM,
             FACTOR=_STEP_FACTOR,
             MINIMUM_STEP=_MINIMUM_STEP,
+            FIRST_SAME_AS_LAST=fsal,
             **chart,
-        )  # fmt: skip
+        )
     )
     return CompiledChart(loop, batch, adaptive)
 
@@ -476,7 +505,9 @@ def _for_chart(name: str, field, advance, record, start=_no_start) -> CompiledCh
 COMPILED: dict[str, CompiledChart] = {
     "matrix": _for_chart("matrix", _matrix_field, _matrix_advance, _matrix_record),
     "quat": _for_chart("quat", _quat_field, _quat_advance, _quat_record, _quat_start),
-    "lie": _for_chart("lie", _lie_field, _lie_advance, _lie_record),
+    "lie": _for_chart(
+        "lie", _lie_field, _lie_advance, _lie_record, fsal=_lie_first_same_as_last
+    ),  # fmt: skip
 }
 """Each chart of :data:`tumble.rigid.charts.CHARTS`, compiled."""
 

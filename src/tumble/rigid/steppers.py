@@ -93,6 +93,8 @@ class RigidStepper(BodyStepper):
         self.error_order = method.tableau.error_order
         self._quat = self.chart.name == "quat"
         self._last: tuple = ()  # the last step's field, z, base point, stages and z_new
+        self._fsal = method.tableau.fsal and self.chart.first_same_as_last is not None
+        self._first: tuple = (None, None)  # (accepted state, its first stage) with FSAL
 
     def start(self, state: tuple[np.ndarray, np.ndarray]) -> RigidState:
         """The stepped state for ``(R, Y)``: the attitude matrix and ``Y = (x, p, L)``."""
@@ -108,9 +110,18 @@ class RigidStepper(BodyStepper):
         z, Rn = chart.pack(*state)
         f = chart.field(self.dynamics, self.method.dexpinv, Rn)
         K = np.empty((tableau.stages, z.size))
-        z_new, error = rk_step(f, t, z, f(t, z), h, tableau, K)
+        first = self._first[1] if self._first[0] is state else f(t, z)
+        z_new, error = rk_step(f, t, z, first, h, tableau, K)
         self._last = (f, z, Rn, K, z_new)
         return chart.advance(z_new, Rn), error
+
+    def accept(self, t: float, state: RigidState) -> None:
+        """With a FSAL tableau keep the accepted step's last stage as the next one's first
+        (:attr:`~tumble.rigid.charts.Chart.first_same_as_last`): one evaluation saved."""
+        if self._fsal:
+            _, _, _, K, z_new = self._last
+            assert self.chart.first_same_as_last is not None
+            self._first = (state, self.chart.first_same_as_last(K, z_new))
 
     def norm(self, error: np.ndarray, old: RigidState, new: RigidState, control: Control) -> float:
         """:func:`~tumble.rigid.charts.error_norm`: the attitude against rtol (radians in
@@ -225,8 +236,8 @@ class CompiledStepper(RigidStepper):
         atol = np.broadcast_to(np.asarray(control.atol, dtype=float), (9,)).copy()
         announce_compilation(self.adaptive_loop, f"the {self.chart.name} chart's adaptive loop")
         count, t_end, h_next, accepted, rejected, code, t_failed, finite = self.adaptive_loop(
-            self.problem, tableau.e, t, t1, h, control.rtol, atol, settings, z, Rn, every,
-            step0, float(max_steps), records,
+            self.problem, tableau.e, t, t1, h, control.rtol, atol, settings, self._fsal, z, Rn,
+            every, step0, float(max_steps), records,
         )  # fmt: skip
         q = records.q[:count] if self._quat else np.empty((count, 0))
         return AdaptiveBlock(
