@@ -10,7 +10,6 @@ in :mod:`tumble.mass`. trimesh is imported inside the functions, on first use.
 
 from __future__ import annotations
 
-import warnings
 from os import PathLike
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -18,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble import _checks
+from tumble import _checks, _parts
 from tumble._atomic import atomic_write
 from tumble.mass import MassProperties, axis_vector, validate_point, validate_torus_radii
 from tumble.so3 import validate_rotation
@@ -355,9 +354,15 @@ def from_mesh(
 
     Uses trimesh's exact polyhedral integrals (Eberly, *Polyhedral Mass Properties*); the
     inertia is about the centre of mass, in the mesh's axes. The mesh must be closed
-    (watertight) and consistently wound. An inside-out mesh (negative signed volume) is
-    refused, unless ``fix_inside_out=True``: then its faces are flipped (on a copy) with a
-    ``UserWarning``.
+    (watertight) and consistently wound, enclose a nonzero volume, and its mass properties
+    must be finite floats.
+
+    A mesh may have several connected parts. Each is checked by its signed volume and its
+    nesting (``tumble._parts``): a part wound inward that lies inside another is a cavity,
+    and its volume is subtracted; a part wound outward inside a cavity is an island. A part
+    wound the other way (an inside-out part lying inside no other, or a cavity wound outward)
+    is refused, naming it, unless ``fix_inside_out=True``: then its faces are flipped (on a
+    copy) with a ``UserWarning``.
 
     Parameters
     ----------
@@ -384,17 +389,14 @@ def from_mesh(
     if isinstance(mesh_or_path, (str, PathLike)):
         mesh_or_path = load(mesh_or_path)
     mesh = validate_solid(mesh_or_path, name="mesh_or_path")
-    triangles = mesh.triangles
-    if mesh.volume < 0:
-        if not fix_inside_out:
-            raise _checks.fail(
-                "mesh_or_path",
-                given,
-                "outward-oriented",
-                remedy=f"it is inside-out (volume {mesh.volume:.6g} < 0); flip it with "
-                "mesh.invert(), or pass fix_inside_out=True",
-            )
-        warnings.warn("mesh is inside-out (negative volume); flipped", UserWarning, 2)
-        triangles = triangles[:, ::-1]
-    props = trimesh.triangles.mass_properties(triangles, density=rho)
-    return MassProperties(props.mass, props.center_mass, np.asarray(props.inertia))
+    triangles = _parts.oriented(mesh.triangles, mesh.faces, given, fix_inside_out)
+    with np.errstate(all="ignore"):  # an overflow is refused below, by name
+        props = trimesh.triangles.mass_properties(triangles, density=rho)
+    inertia = np.asarray(props.inertia)
+    if not (np.isfinite(props.mass) and np.all(np.isfinite(inertia))):
+        raise _checks.fail(
+            "mesh_or_path", given, "a mesh whose mass properties are finite floats",
+            remedy=f"with density={rho:g} kg/m³ and coordinates up to "
+            f"{np.max(np.abs(triangles)):.3g} m they overflow; give it in other units",
+        )  # fmt: skip
+    return MassProperties(props.mass, props.center_mass, inertia)
