@@ -221,3 +221,47 @@ def test_a_valid_stl_passes_the_check(tmp_path, binary):
     else:
         path.write_text(mesh.export(file_type="stl_ascii"))
     assert meshes.load(path).volume == pytest.approx(6.0)
+
+
+TETRAHEDRON_OBJ = "v {x} 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+
+
+@pytest.mark.parametrize("value", ["nan", "inf"])
+def test_a_file_with_non_finite_vertices_is_refused_naming_the_vertex(tmp_path, value):
+    # Issue 18, item 9: trimesh drops the faces of a NaN vertex, and the mesh was called open.
+    path = tmp_path / "tetrahedron.obj"
+    path.write_text(TETRAHEDRON_OBJ.format(x=value))
+    message = rf"must be a mesh file with finite vertex coordinates; vertex 0 is \[{value}, 0"
+    with pytest.raises(ValueError, match=message):
+        meshes.load(path)
+    with pytest.raises(ValueError, match=message):
+        meshes.from_mesh(path, density=1.0)
+
+
+def test_a_mesh_with_non_finite_vertices_is_refused_naming_the_vertex():
+    box = meshes.box([1.0, 1.0, 1.0])
+    vertices = box.vertices.copy()
+    vertices[3, 1] = np.nan
+    mesh = trimesh.Trimesh(vertices, box.faces, process=False)
+    with pytest.raises(
+        ValueError,
+        match=r"mesh_or_path=.* must be a mesh with finite vertex coordinates; vertex 3",
+    ):
+        meshes.from_mesh(mesh, density=1.0)
+
+
+@pytest.mark.parametrize("suffix", ["stl", "obj", "ply"])
+def test_a_closed_box_with_huge_coordinates_loads_closed(tmp_path, suffix):
+    # Issue 18, item 9: trimesh's merge of a box with 1e12 coordinates overflowed its integer
+    # keys and collapsed the box to one vertex, "open". 2**40 = 1.1e12 is exact in float32.
+    side = 2.0**41
+    path = meshes.save(meshes.box([side, side, side]), tmp_path / f"big.{suffix}")
+    mesh = meshes.load(path)
+    assert mesh.is_watertight and len(mesh.vertices) == 8
+    assert meshes.from_mesh(path, density=1.0).mass == side**3  # exact: powers of two
+
+
+def test_load_merges_the_vertices_an_stl_repeats(tmp_path):
+    # A binary STL stores each triangle's 3 corners: 36 for a box, 8 distinct.
+    mesh = meshes.load(meshes.save(meshes.box([1.0, 2.0, 3.0]), tmp_path / "box.stl"))
+    assert (len(mesh.vertices), len(mesh.faces), mesh.is_watertight) == (8, 12, True)

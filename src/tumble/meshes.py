@@ -210,6 +210,7 @@ def validate_solid(mesh: object, *, name: str = "mesh") -> trimesh.Trimesh:
 
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise _checks.fail(name, mesh, "a trimesh.Trimesh with faces or a mesh file path")
+    _check_finite(mesh, name, mesh, "a mesh with finite vertex coordinates")
     if not mesh.is_watertight:
         raise _checks.fail(
             name,
@@ -246,14 +247,15 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
     Returns
     -------
     trimesh.Trimesh
-        Duplicate vertices merged (trimesh's ``process=True``), so a closed STL is
-        watertight.
+        Vertices closer than 1e-8 m merged (as trimesh's ``process=True`` merges them, but
+        without its integer overflow past 9e10 m), so a closed STL is watertight.
 
     Raises
     ------
     ValueError
-        If the file does not exist, has an unknown extension, cannot be parsed, or holds no
-        triangles; the message names ``path`` and what is allowed.
+        If the file does not exist, has an unknown extension, cannot be parsed, holds no
+        triangles, or has a NaN or infinite coordinate; the message names ``path`` and what
+        is allowed.
 
     Examples
     --------
@@ -273,7 +275,7 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
     if file_type == "stl":
         _check_stl(file, path)
     try:
-        mesh = trimesh.load_mesh(file, file_type=file_type)
+        mesh = trimesh.load_mesh(file, file_type=file_type, process=False)
     except Exception as error:  # trimesh raises many types for a bad file
         cause = (
             "the reader needs an optional module that is missing"  # never an ImportError
@@ -290,7 +292,34 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
             "a mesh file with triangles",
             remedy=f"it has none (empty or not a {file_type} file)",
         )
-    return mesh
+    _check_finite(mesh, "path", str(path), "a mesh file with finite vertex coordinates")
+    return _merged(mesh)
+
+
+def _check_finite(mesh: trimesh.Trimesh, name: str, value: object, allowed: str) -> None:
+    """Refuse a mesh with a NaN or infinite coordinate, naming the first such vertex."""
+    bad = ~np.all(np.isfinite(mesh.vertices), axis=1)
+    if np.any(bad):
+        index = int(np.argmax(bad))
+        corner = ", ".join(f"{x:g}" for x in mesh.vertices[index])
+        raise _checks.fail(name, value, allowed, remedy=f"vertex {index} is [{corner}]")
+
+
+def _merged(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh`` with vertices closer than trimesh's ``tol.merge`` (1e-8 m) per coordinate merged.
+
+    trimesh's own merge rounds ``vertex / tol.merge`` to int64, which overflows past about
+    9e10 m and collapses the mesh to one vertex; rounding in floating point does not (past
+    that size the rounding is a no-op and equal vertices merge exactly).
+    """
+    import trimesh
+
+    with np.errstate(over="ignore"):
+        scaled = mesh.vertices / trimesh.tol.merge
+    keys = np.where(np.isfinite(scaled), np.round(scaled), mesh.vertices) + 0.0  # -0.0 -> 0.0
+    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+    faces = inverse.ravel()[mesh.faces]
+    return trimesh.Trimesh(mesh.vertices[first], faces, process=False)
 
 
 def _check_stl(file: Path, path) -> None:
