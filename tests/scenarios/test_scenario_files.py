@@ -435,3 +435,13 @@ def test_an_empty_list_is_refused_where_the_default_is_not_empty(name, option):
 def test_convergence_lists_only_fixed_step_methods():
     with pytest.raises(ValueError, match=r"must be one of euler, .*, rkmk8, split-axes, .*, dmv$"):
         check_options("convergence", {"methods": "rkmk45"})
+
+
+def test_a_primitive_whose_mass_overflows_is_refused_with_the_key(tmp_path):
+    # Issue 18, item 11: the TOML path raised the raw OverflowError of mass.sphere.
+    body = '[options.body]\nshape = "sphere"\nradius = 1e200\ndensity = 1e200\n'
+    path = write(tmp_path, RIGID + body)
+    with pytest.raises(
+        ValueError, match=r"options\.body: radius=1e\+200 is not allowed: .*finite"
+    ):
+        read(path)
