@@ -146,11 +146,21 @@ def _describe(part: int, count: int, triangles: Triangles, labels: Labels, volum
 
 
 def oriented(
-    triangles: ArrayLike, faces: NDArray[np.integer], given: object, fix_inside_out: bool
+    triangles: ArrayLike,
+    faces: NDArray[np.integer],
+    *,
+    name: str,
+    value: object,
+    fix_inside_out: bool = False,
+    fix_hint: str = ", or pass fix_inside_out=True",
 ) -> Triangles:
-    """The mesh's triangles, each part wound to bound a solid (see :mod:`tumble._parts`):
-    outward at even nesting depth, inward (a cavity) at odd depth. A part wound the other
-    way is refused, naming it, or flipped with a warning if ``fix_inside_out``."""
+    """The mesh's triangles, each part wound to bound a solid (module docstring): outward
+    at even nesting depth, inward (a cavity) at odd depth.
+
+    A part wound the other way is refused (the ValueError names ``name``, ``value``, the part
+    and how to flip it, then ``fix_hint``), or flipped with a warning if ``fix_inside_out``.
+    A part that encloses no volume is refused.
+    """
     triangles = np.array(triangles, dtype=float)
     labels = part_labels(faces)
     size = np.max(np.ptp(triangles.reshape(-1, 3), axis=0)) or np.float64(1.0)
@@ -164,7 +174,7 @@ def oriented(
         part = int(np.argmax(flat))
         where = "it" if count == 1 else "its " + _describe(part, count, triangles, labels, 0.0)
         raise fail(
-            "mesh_or_path", given, "a solid of nonzero volume",
+            name, value, "a solid of nonzero volume",
             remedy=f"{where} encloses no volume ({volumes[part] + 0.0:.3g} m³: its faces "
             "lie in one plane, or fold onto each other)",
         )  # fmt: skip
@@ -181,11 +191,10 @@ def oriented(
         ]
     if not fix_inside_out:
         raise fail(
-            "mesh_or_path", given,
+            name, value,
             "outward-oriented" + ("" if count == 1 else " (parts wound outward, cavities inward)"),
             remedy=("it " if count == 1 else "its ") + reasons[0] + "; flip "
-            + ("it with mesh.invert()" if count == 1 else "that part") + ", or pass "
-            "fix_inside_out=True",
+            + ("it with mesh.invert()" if count == 1 else "that part") + fix_hint,
         )  # fmt: skip
     warnings.warn(f"mesh {'; '.join(reasons)}: flipped", UserWarning, 3)
     for k in wrong:

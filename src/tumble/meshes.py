@@ -418,7 +418,9 @@ def from_mesh(
     if isinstance(mesh_or_path, (str, PathLike)):
         mesh_or_path = load(mesh_or_path)
     mesh = validate_solid(mesh_or_path, name="mesh_or_path")
-    triangles = _parts.oriented(mesh.triangles, mesh.faces, given, fix_inside_out)
+    triangles = _parts.oriented(
+        mesh.triangles, mesh.faces, name="mesh_or_path", value=given, fix_inside_out=fix_inside_out
+    )
     with np.errstate(all="ignore"):  # an overflow is refused below, by name
         props = trimesh.triangles.mass_properties(triangles, density=rho)
     inertia = np.asarray(props.inertia)
