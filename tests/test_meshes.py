@@ -265,3 +265,14 @@ def test_load_merges_the_vertices_an_stl_repeats(tmp_path):
     # A binary STL stores each triangle's 3 corners: 36 for a box, 8 distinct.
     mesh = meshes.load(meshes.save(meshes.box([1.0, 2.0, 3.0]), tmp_path / "box.stl"))
     assert (len(mesh.vertices), len(mesh.faces), mesh.is_watertight) == (8, 12, True)
+
+
+@pytest.mark.parametrize("suffix", meshes.TEXT_FORMATS)
+def test_random_bytes_named_as_a_text_format_are_refused_as_not_text(tmp_path, suffix):
+    # Issue 18, item 9: trimesh's text sniffing needs an optional module (charset_normalizer)
+    # and the user read "the reader needs an optional module that is missing".
+    path = tmp_path / f"x.{suffix}"
+    path.write_bytes(np.random.default_rng(5).integers(0, 256, 3000, dtype=np.uint8).tobytes())
+    message = rf"must be a text {suffix} file; its byte \d+ \(0x[0-9a-f]{{2}}\) is not UTF-8"
+    with pytest.raises(ValueError, match=message):
+        meshes.load(path)

@@ -31,6 +31,8 @@ LOAD_FORMATS = ("glb", "gltf", "obj", "off", "ply", "stl")
 """File extensions :func:`load` accepts (trimesh's triangle-mesh readers)."""
 SAVE_FORMATS = ("glb", "obj", "off", "ply", "stl")
 """File extensions :func:`save` writes (trimesh's mesh exporters)."""
+TEXT_FORMATS = ("gltf", "obj", "off")
+"""Formats that are text: a file of one whose bytes are not UTF-8 is refused as such."""
 
 
 def _placement(axis: str | ArrayLike, center: ArrayLike) -> np.ndarray:
@@ -274,6 +276,8 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
     file_type = _suffix(file, LOAD_FORMATS, "path")
     if file_type == "stl":
         _check_stl(file, path)
+    elif file_type in TEXT_FORMATS:
+        _check_text(file, path, file_type)
     try:
         mesh = trimesh.load_mesh(file, file_type=file_type, process=False)
     except Exception as error:  # trimesh raises many types for a bad file
@@ -320,6 +324,20 @@ def _merged(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
     _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
     faces = inverse.ravel()[mesh.faces]
     return trimesh.Trimesh(mesh.vertices[first], faces, process=False)
+
+
+def _check_text(file: Path, path: str | PathLike[str], file_type: str) -> None:
+    """Refuse a file of a text format whose bytes are not UTF-8 (trimesh would guess the
+    encoding with an optional module, and fail for want of it)."""
+    try:
+        file.read_bytes().decode("utf-8")
+    except UnicodeDecodeError as error:
+        byte = error.object[error.start]
+        raise _checks.fail(
+            "path", str(path), f"a text {file_type} file",
+            remedy=f"its byte {error.start} (0x{byte:02x}) is not UTF-8 text, which "
+            f"{file_type} files are",
+        ) from None  # fmt: skip
 
 
 def _check_stl(file: Path, path) -> None:
