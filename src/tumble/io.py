@@ -341,7 +341,6 @@ def load(path: str | Path) -> Run:
         If the folder or its ``summary.json`` / ``data.nc`` is missing or unreadable, or a file
         that ``summary.json`` lists is not in the folder.
     """
-    import xarray as xr
 
     if not isinstance(path, str | PathLike):
         raise _checks.fail("path", path, "a run folder or its data.nc, as a str or Path")
