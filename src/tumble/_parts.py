@@ -60,9 +60,10 @@ def part_labels(faces: NDArray[np.integer]) -> Labels:
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
+    faces = np.asarray(faces, dtype=np.int64)
     n = len(faces)
-    edges = np.sort(np.asarray(faces)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    _, edge = np.unique(edges, axis=0, return_inverse=True)
+    edges = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    _, edge = np.unique(edges[:, 0] * (int(faces.max()) + 1) + edges[:, 1], return_inverse=True)
     nodes = n + int(edge.max()) + 1  # a graph of faces and edges, each face joined to its 3
     joins = (np.repeat(np.arange(n), 3), n + edge.ravel())
     graph = coo_matrix((np.ones(3 * n), joins), shape=(nodes, nodes))
@@ -118,19 +119,21 @@ def enclosing(triangles: Triangles, labels: Labels) -> list[list[int]]:
     size = float(np.max(high - low)) or 1.0
     scaled = (triangles - (low + high) / 2) / size
     count = int(labels.max()) + 1
-    members = [scaled[labels == k] for k in range(count)]
-    boxes = [(part.min(axis=(0, 1)), part.max(axis=(0, 1))) for part in members]
+    order = np.argsort(labels, kind="stable")
+    members = np.split(scaled[order], np.cumsum(np.bincount(labels, minlength=count))[:-1])
+    lows = np.array([part.min(axis=(0, 1)) for part in members])
+    highs = np.array([part.max(axis=(0, 1)) for part in members])
+    held = np.all(lows[None, :] <= lows[:, None], axis=2)  # [i, j]: i's box inside j's
+    held &= np.all(highs[:, None] <= highs[None, :], axis=2)
+    np.fill_diagonal(held, False)
     inside: list[list[int]] = [[] for _ in range(count)]
-    for i, part in enumerate(members):
-        corners = np.unique(part.reshape(-1, 3), axis=0)
+    for i in np.flatnonzero(held.any(axis=1)):
+        corners = np.unique(members[i].reshape(-1, 3), axis=0)
         samples = corners[np.linspace(0, len(corners) - 1, SAMPLES).astype(int)]
-        for j, other in enumerate(members):
-            held = np.all(boxes[j][0] <= boxes[i][0]) and np.all(boxes[i][1] <= boxes[j][1])
-            if i == j or not held:
-                continue
-            winding = [abs(winding_number(point, other)) for point in samples]
+        for j in np.flatnonzero(held[i]):
+            winding = [abs(winding_number(point, members[j])) for point in samples]
             if np.median(winding) > 0.5:
-                inside[i].append(j)
+                inside[i].append(int(j))
     return inside
 
 
@@ -207,7 +210,8 @@ def _wrong_way(inside: list[int]) -> str:
     depth = len(inside)
     if depth == 0:
         return "is inside-out and lies inside no other part, so it is not a cavity"
-    parts = ("part " if depth == 1 else "parts ") + " and ".join(str(j + 1) for j in inside)
+    named = [str(j + 1) for j in inside[:3]] + ["..."] * (depth > 3)
+    parts = f"part {named[0]}" if depth == 1 else f"{depth} parts ({', '.join(named)})"
     if depth % 2:
         return f"lies inside {parts} but is wound outward; there it is a cavity, wound inward"
     return f"lies inside {parts} but is wound inward; there it is an island, wound outward"
