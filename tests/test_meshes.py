@@ -276,3 +276,15 @@ def test_random_bytes_named_as_a_text_format_are_refused_as_not_text(tmp_path, s
     message = rf"must be a text {suffix} file; its byte \d+ \(0x[0-9a-f]{{2}}\) is not UTF-8"
     with pytest.raises(ValueError, match=message):
         meshes.load(path)
+
+
+def test_a_box_collapsed_by_trimeshs_merge_is_refused_with_that_cause():
+    # Issue 18, item 9: trimesh.Trimesh(vertices * 1e12, faces) merges the 8 corners into one
+    # (its int64 merge keys overflow); the mesh was called open, as if a face were missing.
+    box = meshes.box([1.0, 1.0, 1.0])
+    with np.errstate(invalid="ignore"):  # trimesh's own cast warning
+        collapsed = trimesh.Trimesh(box.vertices * 1e12, box.faces)
+    with pytest.raises(ValueError, match=r"face 0 has 1 distinct vertices.*process=False"):
+        meshes.from_mesh(collapsed, density=1.0)
+    whole = trimesh.Trimesh(box.vertices * 1e12, box.faces, process=False)
+    assert meshes.from_mesh(whole, density=1.0).mass == pytest.approx(1e36, rel=1e-12)

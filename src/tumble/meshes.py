@@ -214,12 +214,17 @@ def validate_solid(mesh: object, *, name: str = "mesh") -> trimesh.Trimesh:
         raise _checks.fail(name, mesh, "a trimesh.Trimesh with faces or a mesh file path")
     _check_finite(mesh, name, mesh, "a mesh with finite vertex coordinates")
     if not mesh.is_watertight:
-        raise _checks.fail(
-            name,
-            mesh,
-            "a closed (watertight) surface",
-            remedy="it is open; repair it, e.g. trimesh.repair.fill_holes(mesh)",
-        )
+        distinct = 1 + np.count_nonzero(np.diff(np.sort(mesh.faces, axis=1)), axis=1)
+        collapsed = np.flatnonzero(distinct < 3)
+        remedy = "it is open; repair it, e.g. trimesh.repair.fill_holes(mesh)"
+        if len(collapsed):
+            k = collapsed[0]
+            remedy = (
+                f"face {k} has {distinct[k]} distinct vertices ({len(collapsed)} faces collapsed): "
+                "trimesh's merge collapses vertices past about 9e10 m; build the mesh with "
+                "trimesh.Trimesh(vertices, faces, process=False), or in other units"
+            )
+        raise _checks.fail(name, mesh, "a closed (watertight) surface", remedy=remedy)
     if not mesh.is_winding_consistent:
         raise _checks.fail(
             name,
