@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble import _checks, _parts
+from tumble import _checks, _mesh_files, _parts
 from tumble._atomic import atomic_write
 from tumble.mass import MassProperties, axis_vector, validate_point, validate_torus_radii
 from tumble.so3 import validate_rotation
@@ -220,9 +220,9 @@ def validate_solid(mesh: object, *, name: str = "mesh") -> trimesh.Trimesh:
         if len(collapsed):
             k = collapsed[0]
             remedy = (
-                f"face {k} has {distinct[k]} distinct vertices ({len(collapsed)} faces collapsed): "
-                "trimesh's merge collapses vertices past about 9e10 m; build the mesh with "
-                "trimesh.Trimesh(vertices, faces, process=False), or in other units"
+                f"face {k} has {distinct[k]} distinct vertices ({len(collapsed)} faces "
+                "collapsed): trimesh's merge collapses vertices past about 9e10 m; build the "
+                "mesh with trimesh.Trimesh(vertices, faces, process=False), or in other units"
             )
         raise _checks.fail(name, mesh, "a closed (watertight) surface", remedy=remedy)
     if not mesh.is_winding_consistent:
@@ -280,9 +280,9 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
         raise _checks.fail("path", str(path), "an existing mesh file", remedy="not found")
     file_type = _suffix(file, LOAD_FORMATS, "path")
     if file_type == "stl":
-        _check_stl(file, path)
+        _mesh_files.check_stl(file, path)
     elif file_type in TEXT_FORMATS:
-        _check_text(file, path, file_type)
+        _mesh_files.check_text(file, path, file_type)
     try:
         mesh = trimesh.load_mesh(file, file_type=file_type, process=False)
     except Exception as error:  # trimesh raises many types for a bad file
@@ -302,7 +302,7 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
             remedy=f"it has none (empty or not a {file_type} file)",
         )
     _check_finite(mesh, "path", str(path), "a mesh file with finite vertex coordinates")
-    return _merged(mesh)
+    return _mesh_files.merged(mesh)
 
 
 def _check_finite(mesh: trimesh.Trimesh, name: str, value: object, allowed: str) -> None:
@@ -312,59 +312,6 @@ def _check_finite(mesh: trimesh.Trimesh, name: str, value: object, allowed: str)
         index = int(np.argmax(bad))
         corner = ", ".join(f"{x:g}" for x in mesh.vertices[index])
         raise _checks.fail(name, value, allowed, remedy=f"vertex {index} is [{corner}]")
-
-
-def _merged(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
-    """``mesh`` with vertices closer than trimesh's ``tol.merge`` (1e-8 m) per coordinate merged.
-
-    trimesh's own merge rounds ``vertex / tol.merge`` to int64, which overflows past about
-    9e10 m and collapses the mesh to one vertex; rounding in floating point does not (past
-    that size the rounding is a no-op and equal vertices merge exactly).
-    """
-    import trimesh
-
-    with np.errstate(over="ignore"):
-        scaled = mesh.vertices / trimesh.tol.merge
-    keys = np.where(np.isfinite(scaled), np.round(scaled), mesh.vertices) + 0.0  # -0.0 -> 0.0
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    faces = inverse.ravel()[mesh.faces]
-    return trimesh.Trimesh(mesh.vertices[first], faces, process=False)
-
-
-def _check_text(file: Path, path: str | PathLike[str], file_type: str) -> None:
-    """Refuse a file of a text format whose bytes are not UTF-8 (trimesh would guess the
-    encoding with an optional module, and fail for want of it)."""
-    try:
-        file.read_bytes().decode("utf-8")
-    except UnicodeDecodeError as error:
-        byte = error.object[error.start]
-        raise _checks.fail(
-            "path", str(path), f"a text {file_type} file",
-            remedy=f"its byte {error.start} (0x{byte:02x}) is not UTF-8 text, which "
-            f"{file_type} files are",
-        ) from None  # fmt: skip
-
-
-def _check_stl(file: Path, path) -> None:
-    """Refuse a file that is neither ASCII STL (text starting ``solid``) nor binary STL (an
-    80-byte header, a triangle count n, then 50 bytes per triangle: 84 + 50 n bytes)."""
-    size = file.stat().st_size
-    with open(file, "rb") as handle:
-        head = handle.read(84)
-    if head[:5].lower() == b"solid":
-        try:
-            head.decode("ascii")
-            return
-        except UnicodeDecodeError:
-            pass  # a binary file whose header starts with "solid": check it as binary
-    count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
-    if count >= 0 and size == 84 + 50 * count:
-        return
-    raise _checks.fail(
-        "path", str(path), "an STL file",
-        remedy=f"it is neither ASCII STL (text starting 'solid') nor binary STL (84 + 50 n "
-        f"bytes for n triangles: this file has {size} bytes and its header says n = {count})",
-    )  # fmt: skip
 
 
 def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
