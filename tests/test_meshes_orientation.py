@@ -8,6 +8,9 @@ depth (a cavity). Closed forms are those of :mod:`tumble.mass` (boxes are exact 
 import numpy as np
 import pytest
 import trimesh
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from strategies import points, rotation_matrices
 
 from tumble import _parts, mass, meshes
 
@@ -136,3 +139,25 @@ def test_winding_number_is_one_inside_and_zero_outside_and_flips_with_the_windin
     assert _parts.winding_number(np.array(point), triangles) == pytest.approx(expected, abs=1e-12)
     reversed_ = triangles[:, ::-1]
     assert _parts.winding_number(np.array(point), reversed_) == pytest.approx(-expected, abs=1e-12)
+
+
+@settings(max_examples=25)
+@given(
+    rotation=rotation_matrices(),
+    offset=points(scale=100.0),
+    scale=st.floats(1e-3, 1e3),
+    gap=st.floats(0.01, 10.0),
+)
+def test_parts_are_judged_the_same_wherever_the_mesh_is_placed(rotation, offset, scale, gap):
+    """A hollow box keeps its cavity, and a separate inside-out box is refused, after any
+    rotation, translation and scaling; the masses are the closed forms."""
+    place = np.eye(4)
+    place[:3, :3], place[:3, 3] = scale * rotation, offset
+    outer, hole = meshes.box([2.0, 2.0, 2.0]), _inverted(meshes.box([1.0, 1.0, 1.0]))
+    apart = _inverted(meshes.box([0.5, 0.5, 0.5], center=(1.25 + gap, 0.0, 0.0)))
+    hollow = _join(outer, hole).apply_transform(place)
+    assert meshes.from_mesh(hollow, density=1.0).mass == pytest.approx(7 * scale**3, rel=1e-9)
+    with pytest.raises(ValueError, match=r"part 2 of 2 .* is inside-out and lies inside no"):
+        meshes.from_mesh(
+            _join(meshes.box([2.0, 2.0, 2.0]), apart).apply_transform(place), density=1.0
+        )
