@@ -384,7 +384,7 @@ def from_mesh(
     import trimesh
 
     rho = _checks.positive("density", density, "kg/m³")
-    given = mesh_or_path
+    given = str(mesh_or_path) if isinstance(mesh_or_path, PathLike) else mesh_or_path
     if isinstance(mesh_or_path, (str, PathLike)):
         mesh_or_path = load(mesh_or_path)
     mesh = validate_solid(mesh_or_path, name="mesh_or_path")
