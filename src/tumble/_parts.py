@@ -74,28 +74,25 @@ def part_labels(faces: NDArray[np.integer]) -> Labels:
     return rank[inverse.ravel()]
 
 
-def _triple(triangles: Triangles) -> NDArray[np.float64]:
-    """6 × the signed volume of each triangle's tetrahedron with the origin."""
-    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+def _triples(triangles: Triangles, labels: Labels) -> NDArray[np.float64]:
+    """``a·(b × c)`` of each triangle, its corners taken relative to its part's first corner
+    (6 × the signed volume of the tetrahedron it spans with that corner)."""
+    first = np.unique(labels, return_index=True)[1]
+    a, b, c = np.moveaxis(triangles - triangles[first, 0][labels][:, None, :], 1, 0)
     return np.einsum("ij,ij->i", a, np.cross(b, c))
 
 
 def signed_volumes(triangles: Triangles, labels: Labels) -> NDArray[np.float64]:
     """Signed volume of each part (> 0 wound outward), by the divergence theorem
-    ``V = Σ a·(b × c) / 6``; each part is taken relative to its own first corner."""
-    count = int(labels.max()) + 1
-    first = np.unique(labels, return_index=True)[1]
-    origin = triangles[first, 0][labels]  # translation-invariant for a closed part
-    return np.bincount(labels, _triple(triangles - origin[:, None, :]), count) / 6
+    ``V = Σ a·(b × c) / 6``; each part is taken relative to its own first corner (the sum is
+    translation-invariant for a closed part, and smaller terms round off less)."""
+    return np.bincount(labels, _triples(triangles, labels), int(labels.max()) + 1) / 6
 
 
 def swept_volumes(triangles: Triangles, labels: Labels) -> NDArray[np.float64]:
-    """``Σ |a·(b × c)| / 6`` per part about its first corner: the scale of the round-off in
-    :func:`signed_volumes` (a flat closed part has signed volume 0 to round-off of this)."""
-    count = int(labels.max()) + 1
-    first = np.unique(labels, return_index=True)[1]
-    origin = triangles[first, 0][labels]
-    return np.bincount(labels, np.abs(_triple(triangles - origin[:, None, :])), count) / 6
+    """``Σ |a·(b × c)| / 6`` per part, as in :func:`signed_volumes`: the scale of its round-off
+    (a flat closed part has signed volume 0 to round-off of this)."""
+    return np.bincount(labels, np.abs(_triples(triangles, labels)), int(labels.max()) + 1) / 6
 
 
 def winding_number(point: NDArray[np.float64], triangles: Triangles) -> float:
