@@ -32,9 +32,12 @@ def merged(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
     with np.errstate(over="ignore"):
         scaled = mesh.vertices / trimesh.tol.merge
     keys = np.where(np.isfinite(scaled), np.round(scaled), mesh.vertices) + 0.0  # -0.0 -> 0.0
-    _, first, inverse = np.unique(keys, axis=0, return_index=True, return_inverse=True)
-    faces = inverse.ravel()[mesh.faces]
-    return trimesh.Trimesh(mesh.vertices[first], faces, process=False)
+    order = np.lexsort(keys.T[::-1])  # np.unique(axis=0) does this 4x slower
+    ordered = keys[order]
+    new = np.r_[True, np.any(ordered[1:] != ordered[:-1], axis=1)]
+    inverse = np.empty(len(keys), dtype=np.int64)
+    inverse[order] = np.cumsum(new) - 1
+    return trimesh.Trimesh(mesh.vertices[order[new]], inverse[mesh.faces], process=False)
 
 
 def check_text(file: Path, path: str | PathLike[str], file_type: str) -> None:
