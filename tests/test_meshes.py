@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from tumble import meshes
+from tumble import _mesh_files, meshes
 
 # SPEC §4 closed forms for the torus R = 1, r = 0.5, rho = 1.
 TORUS_VOLUME = 2 * np.pi**2 * 1.0 * 0.5**2
@@ -288,3 +288,18 @@ def test_a_box_collapsed_by_trimeshs_merge_is_refused_with_that_cause():
         meshes.from_mesh(collapsed, density=1.0)
     whole = trimesh.Trimesh(box.vertices * 1e12, box.faces, process=False)
     assert meshes.from_mesh(whole, density=1.0).mass == pytest.approx(1e36, rel=1e-12)
+
+
+def test_the_merge_joins_corners_closer_than_trimeshs_tolerance():
+    # Each triangle its own 3 corners, moved by up to 1e-10 m (< tol.merge = 1e-8 m): one
+    # closed box again, as trimesh's own merge would give. (Exporters round to 8 digits, so
+    # the merge is called directly.)
+    box = meshes.box([1.0, 2.0, 3.0])
+    noise = np.random.default_rng(1).uniform(-1e-10, 1e-10, (36, 3))
+    loose = trimesh.Trimesh(
+        box.triangles.reshape(-1, 3) + noise, np.arange(36).reshape(12, 3), process=False
+    )
+    assert len(np.unique(loose.vertices, axis=0)) == 36 and not loose.is_watertight
+    mesh = _mesh_files.merged(loose)
+    assert (len(mesh.vertices), mesh.is_watertight) == (8, True)
+    assert mesh.volume == pytest.approx(6.0, rel=1e-9)
