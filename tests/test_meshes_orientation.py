@@ -161,3 +161,13 @@ def test_parts_are_judged_the_same_wherever_the_mesh_is_placed(rotation, offset,
         meshes.from_mesh(
             _join(meshes.box([2.0, 2.0, 2.0]), apart).apply_transform(place), density=1.0
         )
+
+
+def test_a_part_in_the_hole_of_a_torus_is_beside_it_not_inside_it():
+    # Its bounding box is inside the torus's, but the torus's winding number there is 0.
+    ring, plug = meshes.torus(2.0, 0.5, 32), meshes.box([0.5, 0.5, 0.5])
+    body = meshes.from_mesh(_join(ring, plug), density=1.0)
+    expected = meshes.from_mesh(ring, density=1.0).mass + 0.125
+    assert body.mass == pytest.approx(expected, rel=1e-13)
+    with pytest.raises(ValueError, match=r"part 2 of 2 .* is inside-out and lies inside no other"):
+        meshes.from_mesh(_join(ring, _inverted(plug)), density=1.0)
