@@ -127,9 +127,9 @@ def array(
     ...
     ValueError: x0=[0.0, 1.0] is not allowed: must be of shape (3,), every entry finite (m)
     """
-    wanted = "every entry finite and > 0" if positive else "every entry finite"
-    if shape is not None:
-        wanted = f"of shape {tuple(shape)}, {wanted}"
+    each = "finite and > 0" if positive else "finite"
+    whole = "an array of numbers" if shape is None else f"of shape {tuple(shape)}"
+    wanted = f"{whole}, every entry {each}"
     try:
         result = np.array(value, dtype=float)
     except (TypeError, ValueError):
@@ -142,7 +142,7 @@ def array(
             raise fail(name, value, wanted, unit)
         index = tuple(int(i) for i in np.argwhere(~good)[0])
         label = f"{name}[{', '.join(map(str, index))}]"
-        raise fail(label, float(result[index]), wanted.replace("every entry ", ""), unit)
+        raise fail(label, float(result[index]), each, unit)
     return result
 
 

@@ -387,8 +387,9 @@ def mass_properties(
     with _reported(), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            mesh = meshes.load(mesh_file)
-            properties = meshes.from_mesh(mesh, density=density, fix_inside_out=fix_inside_out)
+            properties = meshes.from_mesh(  # a refusal names the file, as given
+                mesh_file, density=density, fix_inside_out=fix_inside_out
+            )
         except ValueError as error:  # name the command-line option, not the argument
             message = str(error).replace("fix_inside_out=True", "--fix-inside-out")
             raise ValueError(message) from None

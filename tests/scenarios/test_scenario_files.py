@@ -435,3 +435,27 @@ def test_an_empty_list_is_refused_where_the_default_is_not_empty(name, option):
 def test_convergence_lists_only_fixed_step_methods():
     with pytest.raises(ValueError, match=r"must be one of euler, .*, rkmk8, split-axes, .*, dmv$"):
         check_options("convergence", {"methods": "rkmk45"})
+
+
+def test_a_primitive_whose_mass_overflows_is_refused_with_the_key(tmp_path):
+    # Issue 18, item 11: the TOML path raised the raw OverflowError of mass.sphere.
+    body = '[options.body]\nshape = "sphere"\nradius = 1e200\ndensity = 1e200\n'
+    path = write(tmp_path, RIGID + body)
+    with pytest.raises(
+        ValueError, match=r"options\.body: radius=1e\+200 is not allowed: .*finite"
+    ):
+        read(path)
+
+
+def test_a_mesh_with_a_separate_inside_out_part_is_refused_with_the_key(tmp_path):
+    # Issue 18, item 1: only the sign of the total volume was checked.
+    small = meshes.box([0.5, 0.5, 0.5], center=(1.5, 0.0, 0.0))
+    small.invert()
+    trimesh.util.concatenate([meshes.box([2.0, 2.0, 2.0]), small]).export(tmp_path / "two.stl")
+    path = write(tmp_path, RIGID + '[options.body]\nmesh = "two.stl"\ndensity = 1.0\n')
+    with pytest.raises(
+        ValueError,
+        match=r"options\.body\.mesh = 'two.stl': .*part 2 of 2 .* is inside-out .*flip that "
+        r"part and save the file again",
+    ):
+        read(path)
