@@ -297,7 +297,7 @@ BAD_FILES = {
     "tolerance for a fixed step": (
         RIGID + "[options]\nrtol = 1e-6\n" + CYLINDER,
         "options: rtol=1e-06 is not allowed: must be None for the fixed-step method 'rkmk4'; "
-        "tolerances apply only to method='rkmk45'",
+        "tolerances apply only to the adaptive methods ('rkmk45', 'rkmk-dopri5')",
     ),
 }
 
