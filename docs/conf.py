@@ -1,0 +1,128 @@
+"""Sphinx configuration of tumble's site: ``make docs`` builds it into ``build/docs/html``.
+
+The narrative is docs/*.md (MyST), the gallery is examples/*.py run by sphinx-gallery (their
+matplotlib figures become the pictures), the API reference is autodoc + numpydoc over each
+public module (docs/api/). Nothing here reaches the network: no intersphinx.
+"""
+
+from __future__ import annotations
+
+import importlib
+from pathlib import Path
+
+from docutils import nodes
+from docutils.parsers.rst import Directive
+from docutils.statemachine import StringList
+
+import tumble
+
+HERE = Path(__file__).parent
+
+project = "tumble"
+author = "the tumble developers"
+copyright = "the tumble developers"
+release = version = tumble.__version__
+
+extensions = [
+    "myst_parser",
+    "numpydoc",
+    "sphinx.ext.autodoc",
+    "sphinx.ext.mathjax",
+    "sphinx_gallery.gen_gallery",
+]
+
+source_suffix = {".rst": "restructuredtext", ".md": "markdown"}
+root_doc = "index"
+exclude_patterns = ["_build", "**.ipynb_checkpoints", "make_images.py"]
+# The narrative pages are also read on GitHub: they link `#heading-slugs` and `img/...`.
+myst_heading_anchors = 3
+myst_enable_extensions = ["dollarmath"]
+# Links from a page to a file of the repository outside docs/ (right on GitHub), and the page
+# of the site that shows it.
+REPOSITORY_LINKS = {"../benchmarks/results.md": "benchmarks.md"}
+default_role = "py:obj"  # `name` in a docstring links to it when it is documented
+# numpydoc turns each "References" entry into a citation; an entry the text does not cite is
+# usual in tumble's docstrings (the list is the sources), not an error.
+suppress_warnings = ["ref.citation"]
+
+# API: numpydoc renders the docstrings; signatures without type hints (the Parameters say it).
+autodoc_typehints = "none"
+autodoc_member_order = "bysource"
+autodoc_default_options = {"members": True, "show-inheritance": False}
+numpydoc_show_class_members = False  # the class body is documented by autodoc itself
+numpydoc_class_members_toctree = False
+numpydoc_validation_checks: set[str] = set()  # validated by review, not by the build
+numpydoc_xref_param_type = False
+
+# The gallery: every example is run once (a few seconds each at its own default sizes) and
+# its matplotlib figures are the pictures; the printed numbers are shown under the code.
+sphinx_gallery_conf = {
+    "examples_dirs": str(HERE.parent / "examples"),
+    "gallery_dirs": "auto_examples",
+    "filename_pattern": r"\.py$",  # run them all
+    "download_all_examples": False,
+    "remove_config_comments": True,
+    "within_subsection_order": "FileNameSortKey",
+    "plot_gallery": "True",
+    "capture_repr": (),
+    "matplotlib_animations": False,
+    "write_computation_times": False,
+}
+
+html_theme = "pydata_sphinx_theme"
+html_title = f"tumble {version}"
+html_static_path: list[str] = []
+html_theme_options = {
+    "navbar_align": "left",
+    "show_toc_level": 2,
+    "secondary_sidebar_items": ["page-toc"],
+    "footer_start": ["copyright"],
+    "footer_end": ["sphinx-version"],
+}
+html_sidebars = {"index": [], "auto_examples/index": []}
+
+
+def _resolve_top_level(app, env, node, contnode):
+    """Send ``tumble.simulate`` (a name ``tumble`` re-exports) to ``tumble.rigid.simulate``.
+
+    The package docstring and the pages name things as users import them; autodoc documents
+    each object once, where it is defined by its subpackage.
+    """
+    target = node.get("reftarget", "")
+    name = target.removeprefix("tumble.")
+    home = tumble._NAMES.get(name)
+    if node.get("refdomain") != "py" or home is None or target not in (name, f"tumble.{name}"):
+        return None
+    domain = env.get_domain("py")
+    node["reftarget"] = f"{home}.{name}"
+    return domain.resolve_xref(
+        env, node["refdoc"], app.builder, node["reftype"], f"{home}.{name}", node, contnode
+    )
+
+
+def _site_links(app, docname, source):
+    """Point links to repository files outside docs/ at the site's page for them."""
+    for link, page in REPOSITORY_LINKS.items():
+        source[0] = source[0].replace(f"]({link})", f"]({page})")
+
+
+class TumbleNames(Directive):
+    """``.. tumble-names::``: a list of ``tumble.__all__``, each linked where it is documented."""
+
+    def run(self):
+        lines = []
+        for name in tumble.__all__:
+            if name in tumble._SUBMODULES:
+                lines.append(f"* :mod:`tumble.{name}` — :doc:`{name}`")
+            else:
+                lines.append(f"* :obj:`tumble.{name} <{tumble._NAMES[name]}.{name}>`")
+        container = nodes.container()
+        self.state.nested_parse(StringList(lines, "tumble-names"), self.content_offset, container)
+        return container.children
+
+
+def setup(app):
+    importlib.import_module("tumble.rigid")  # fail early, with the import error, if broken
+    app.connect("missing-reference", _resolve_top_level)
+    app.connect("source-read", _site_links)
+    app.add_directive("tumble-names", TumbleNames)
