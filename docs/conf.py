@@ -8,11 +8,14 @@ public module (docs/api/). Nothing here reaches the network: no intersphinx.
 from __future__ import annotations
 
 import importlib
+import inspect
+import pkgutil
 from pathlib import Path
 
 from docutils import nodes
 from docutils.parsers.rst import Directive
 from docutils.statemachine import StringList
+from sphinx.pycode import ModuleAnalyzer
 
 import tumble
 
@@ -106,6 +109,65 @@ def _site_links(app, docname, source):
         source[0] = source[0].replace(f"]({link})", f"]({page})")
 
 
+def _constants_without_docstring(module_name: str) -> list[str]:
+    """The constants in ``module_name.__all__`` that automodule leaves out.
+
+    autodoc documents a module's constant only when the module itself has the docstring under
+    its assignment; a constant re-exported from a submodule (``tumble.ode.TABLEAUX``) has none.
+    """
+    module = importlib.import_module(module_name)
+    documented = ModuleAnalyzer.for_module(module_name).find_attr_docs()
+    return [
+        name
+        for name in getattr(module, "__all__", ())
+        if not (inspect.ismodule(value := getattr(module, name)) or callable(value))
+        and ("", name) not in documented
+    ]
+
+
+def _docstring_from_home(app, what, name, obj, options, lines):
+    """A re-exported constant's docstring, read from the submodule that defines it.
+
+    autodoc reads a constant's docstring (the string under its assignment) only from the
+    module it documents, so ``tumble.ode.TABLEAUX`` would otherwise be shown without the text
+    under ``TABLEAUX = ...`` in tumble/ode/tableaux.py.
+    """
+    if what != "data":
+        return
+    inherited = inspect.cleandoc(getattr(obj, "__doc__", None) or "")  # its class's docstring
+    if lines and "\n".join(lines).strip() != inherited.strip():
+        return
+    package, _, attribute = name.rpartition(".")
+    module = importlib.import_module(package)
+    for info in pkgutil.iter_modules(getattr(module, "__path__", [])):
+        docs = ModuleAnalyzer.for_module(f"{package}.{info.name}").find_attr_docs()
+        if ("", attribute) in docs:
+            lines[:] = list(docs[("", attribute)])
+            return
+    lines[:] = []
+
+
+class TumbleConstants(Directive):
+    """``.. tumble-constants:: module``: autodata for what :func:`_constants_without_docstring`
+    finds, the value shown when it fits on a line."""
+
+    required_arguments = 1
+
+    def run(self):
+        module_name = self.arguments[0]
+        lines = []
+        for name in _constants_without_docstring(module_name):
+            lines.append(f".. autodata:: {module_name}.{name}")
+            if len(repr(getattr(importlib.import_module(module_name), name))) > 80:
+                lines.append("   :no-value:")
+            lines.append("")
+        container = nodes.container()
+        self.state.nested_parse(
+            StringList(lines, "tumble-constants"), self.content_offset, container
+        )
+        return container.children
+
+
 class TumbleNames(Directive):
     """``.. tumble-names::``: a list of ``tumble.__all__``, each linked where it is documented."""
 
@@ -125,4 +187,7 @@ def setup(app):
     importlib.import_module("tumble.rigid")  # fail early, with the import error, if broken
     app.connect("missing-reference", _resolve_top_level)
     app.connect("source-read", _site_links)
+    # before numpydoc's (priority 500) reformatting of the same lines
+    app.connect("autodoc-process-docstring", _docstring_from_home, priority=400)
     app.add_directive("tumble-names", TumbleNames)
+    app.add_directive("tumble-constants", TumbleConstants)
