@@ -70,6 +70,10 @@ sphinx_gallery_conf = {
     "capture_repr": (),
     "matplotlib_animations": False,
     "write_computation_times": False,
+    # which example uses which tumble name (docs/gen_modules/, git-ignored): the index's
+    # minigallery of all examples needs it
+    "backreferences_dir": "gen_modules/backreferences",
+    "doc_module": ("tumble",),
 }
 
 html_theme = "pydata_sphinx_theme"

@@ -36,7 +36,8 @@ PAGES = sorted(path.stem for path in (ROOT / "docs").glob("*.md"))
 def site(tmp_path_factory):
     """``(html folder, seconds, log)`` of a build with ``make docs``'s options."""
     sources = tmp_path_factory.mktemp("site")
-    ignore = shutil.ignore_patterns("auto_examples", "_build", "sg_execution_times.rst")
+    generated = ("auto_examples", "gen_modules", "_build", "sg_execution_times.rst")
+    ignore = shutil.ignore_patterns(*generated)
     for folder in ("docs", "examples"):
         shutil.copytree(ROOT / folder, sources / folder, ignore=ignore)
     (sources / "benchmarks").mkdir()
@@ -153,7 +154,7 @@ def open_page(browser, html: Path, page: str) -> None:
     )
 
 
-def test_index_shows_the_title_and_links_every_page(site, browser):
+def test_index_shows_the_title_links_every_page_and_the_gallery(site, browser):
     from selenium.webdriver.common.by import By
 
     html = site[0]
@@ -166,6 +167,10 @@ def test_index_shows_the_title_and_links_every_page(site, browser):
     }
     expected = {f"{name}.html" for name in PAGES if name != "index"}
     assert expected | {"auto_examples/index.html", "api/index.html"} <= links
+    gallery = browser.find_elements(By.CSS_SELECTOR, ".sphx-glr-thumbcontainer a")
+    assert {f"auto_examples/{name}.html" for name in EXAMPLES} == {
+        link.get_attribute("href").removeprefix(html.as_uri() + "/") for link in gallery
+    }
 
 
 def test_api_page_shows_solve_with_its_signature(site, browser):
