@@ -113,6 +113,26 @@ def _site_links(app, docname, source):
         source[0] = source[0].replace(f"]({link})", f"]({page})")
 
 
+def _pages_joining_the_user_guide(app, docname, source):
+    """Add the docs/*.md pages that user-guide.md does not list to the end of its toctree.
+
+    A new page is then part of the site (a page in no toctree is a warning, so an error)
+    until someone gives it its place in the list.
+    """
+    if docname != "user-guide":
+        return
+    head, fence, tail = source[0].partition("```{toctree}\n")
+    block, end, rest = tail.partition("```")
+    listed = {line.strip() for line in block.splitlines()}
+    extra = sorted({page.stem for page in HERE.glob("*.md")} - listed - {"index", "user-guide"})
+    source[0] = head + fence + block + "".join(f"{page}\n" for page in extra) + end + rest
+
+
+def _reread_the_user_guide(app, env, added, changed, removed):
+    """A page added or removed changes the user guide's toctree (an incremental build)."""
+    return ["user-guide"] if added or removed else []
+
+
 def _constants_without_docstring(module_name: str) -> list[str]:
     """The constants in ``module_name.__all__`` that automodule leaves out.
 
@@ -191,6 +211,8 @@ def setup(app):
     importlib.import_module("tumble.rigid")  # fail early, with the import error, if broken
     app.connect("missing-reference", _resolve_top_level)
     app.connect("source-read", _site_links)
+    app.connect("source-read", _pages_joining_the_user_guide)
+    app.connect("env-get-outdated", _reread_the_user_guide)
     # before numpydoc's (priority 500) reformatting of the same lines
     app.connect("autodoc-process-docstring", _docstring_from_home, priority=400)
     app.add_directive("tumble-names", TumbleNames)
