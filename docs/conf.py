@@ -10,6 +10,7 @@ from __future__ import annotations
 import importlib
 import inspect
 import pkgutil
+import re
 from pathlib import Path
 
 from docutils import nodes
@@ -57,12 +58,16 @@ numpydoc_class_members_toctree = False
 numpydoc_validation_checks: set[str] = set()  # validated by review, not by the build
 numpydoc_xref_param_type = False
 
-# The gallery: every example is run once (a few seconds each at its own default sizes) and
-# its matplotlib figures are the pictures; the printed numbers are shown under the code.
+# The gallery: every example is run once (a second or two each at its own default sizes),
+# its matplotlib figures are the pictures and what it prints is shown, except those named
+# here, which are shown without being run. sphinx-gallery runs an example without __file__.
+NOT_RUN = {
+    "flip_map": "a Dask sweep on a local cluster of every core, its TOML found from __file__",
+}
 sphinx_gallery_conf = {
     "examples_dirs": str(HERE.parent / "examples"),
     "gallery_dirs": "auto_examples",
-    "filename_pattern": r"\.py$",  # run them all
+    "filename_pattern": rf"/(?!({'|'.join(NOT_RUN)})\.py$)[^/]+\.py$",
     "download_all_examples": False,
     "remove_config_comments": True,
     "within_subsection_order": "FileNameSortKey",
@@ -126,6 +131,25 @@ def _pages_joining_the_user_guide(app, docname, source):
     listed = {line.strip() for line in block.splitlines()}
     extra = sorted({page.stem for page in HERE.glob("*.md")} - listed - {"index", "user-guide"})
     source[0] = head + fence + block + "".join(f"{page}\n" for page in extra) + end + rest
+
+
+def _example_title(app, docname, source):
+    """Give an example whose docstring starts without a reST title one: its first line.
+
+    sphinx-gallery takes that line as the thumbnail's title but copies the docstring as it
+    is, and a page without a title gets no link in the gallery's toctree (a warning).
+    """
+    if not docname.startswith("auto_examples/") or docname == "auto_examples/index":
+        return
+    label = f".. _sphx_glr_{docname.replace('/', '_')}.py:\n\n"
+    head, found, body = source[0].partition(label)
+    lines = body.split("\n", 2)
+    if not found or len(lines) < 2 or re.fullmatch(r"([=\-~^\"'`#*+])\1+\s*", lines[1]):
+        return
+    title = lines[0].strip()
+    if not lines[1].strip():  # a one-line first paragraph becomes the title
+        body = body.split("\n", 1)[1]
+    source[0] = head + found + f"{title}\n{'=' * len(title)}\n" + body
 
 
 def _reread_the_user_guide(app, env, added, changed, removed):
@@ -213,6 +237,7 @@ def setup(app):
     app.connect("source-read", _site_links)
     app.connect("source-read", _pages_joining_the_user_guide)
     app.connect("env-get-outdated", _reread_the_user_guide)
+    app.connect("source-read", _example_title)
     # before numpydoc's (priority 500) reformatting of the same lines
     app.connect("autodoc-process-docstring", _docstring_from_home, priority=400)
     app.add_directive("tumble-names", TumbleNames)
