@@ -173,6 +173,41 @@ def _constants_without_docstring(module_name: str) -> list[str]:
     ]
 
 
+LITERAL_SPAN = re.compile(r"(``.*?``|`[^`]*`)")
+
+
+def escape_bars(lines: list[str]) -> list[str]:
+    """``|x|`` in docstring prose, tumble's plain-text norm, as ``\\|x\\|`` for docutils.
+
+    reStructuredText reads ``|L|`` as a substitution (an error, or text lost). Left alone:
+    inline literals and roles, doctests and their output, indented blocks under a directive
+    or a ``::`` paragraph (math, code), and table lines.
+    """
+    escaped, block_indent, doctest = [], None, False
+    for line in lines:
+        stripped = line.lstrip()
+        indent = len(line) - len(stripped)
+        if block_indent is not None and (not stripped or indent > block_indent):
+            escaped.append(line)  # inside a literal, math or directive block
+            continue
+        block_indent = None
+        doctest = stripped.startswith((">>>", "...")) or (doctest and bool(stripped))
+        if doctest or stripped.startswith(("|", "+-", "+=")) or "|" not in line:
+            escaped.append(line)
+        else:
+            parts = LITERAL_SPAN.split(line)
+            escaped.append(
+                "".join(p if k % 2 else p.replace("|", "\\|") for k, p in enumerate(parts))
+            )
+        if stripped.startswith(".. ") and "::" in stripped or stripped.endswith("::"):
+            block_indent = indent
+    return escaped
+
+
+def _escape_bars(app, what, name, obj, options, lines):
+    lines[:] = escape_bars(lines)
+
+
 def _docstring_from_home(app, what, name, obj, options, lines):
     """A re-exported constant's docstring, read from the submodule that defines it.
 
@@ -240,5 +275,6 @@ def setup(app):
     app.connect("source-read", _example_title)
     # before numpydoc's (priority 500) reformatting of the same lines
     app.connect("autodoc-process-docstring", _docstring_from_home, priority=400)
+    app.connect("autodoc-process-docstring", _escape_bars, priority=401)
     app.add_directive("tumble-names", TumbleNames)
     app.add_directive("tumble-constants", TumbleConstants)

@@ -98,7 +98,7 @@ def test_every_public_name_of_every_api_page_has_an_entry(site):
             home = f"{getattr(value, '__module__', '')}.{getattr(value, '__qualname__', '')}"
             if f"{module_name}.{name}" not in found and home not in found:
                 missing.append(f"{module_name}.{name}")
-    assert missing == []
+    assert not missing, f"no entry in the built site for: {missing}"
 
 
 def test_every_public_module_is_on_an_api_page():
@@ -117,7 +117,8 @@ def test_every_public_module_is_on_an_api_page():
                 if not sub.name.rpartition(".")[2].startswith("_")
             }
     assert "tumble.viz.html" in expected
-    assert sorted(expected - set(AUTOMODULE.findall(API_SOURCES))) == []
+    missing = sorted(expected - set(AUTOMODULE.findall(API_SOURCES)))
+    assert not missing, f"give these an automodule on a docs/api/ page: {missing}"
 
 
 def test_every_name_of_tumble_all_links_to_its_entry(site):
@@ -188,12 +189,41 @@ def test_api_page_shows_solve_with_its_signature(site, browser):
     assert browser.title.startswith("tumble.ode")
 
 
-def not_run() -> dict[str, str]:
-    """docs/conf.py's examples shown without being run (name: why)."""
+def sphinx_conf():
+    """docs/conf.py as a module."""
     spec = importlib.util.spec_from_file_location("docs_conf", ROOT / "docs" / "conf.py")
     conf = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(conf)
-    return conf.NOT_RUN
+    return conf
+
+
+def not_run() -> dict[str, str]:
+    """docs/conf.py's examples shown without being run (name: why)."""
+    return sphinx_conf().NOT_RUN
+
+
+def test_bars_are_escaped_in_prose_only():
+    """``|L|`` (a norm in tumble's docstrings) is not a reST substitution; code keeps its bars."""
+    lines = [
+        "the momentum |L|² = |Iω|², ``|x|`` and :math:`|a|`",
+        "x : float | None",
+        ">>> a | b",
+        "3 | 4",
+        "",
+        ".. math::",
+        "",
+        "   |x| = 1",
+        "Run::",
+        "",
+        "    code | here",
+        "after |y|",
+    ]
+    assert sphinx_conf().escape_bars(lines) == [
+        r"the momentum \|L\|² = \|Iω\|², ``|x|`` and :math:`|a|`",
+        r"x : float \| None",
+        *lines[2:11],
+        r"after \|y\|",
+    ]
 
 
 def test_gallery_shows_a_picture_of_every_example_it_runs(site, browser):
