@@ -17,6 +17,7 @@ from docutils import nodes
 from docutils.parsers.rst import Directive
 from docutils.statemachine import StringList
 from sphinx.pycode import ModuleAnalyzer
+from sphinx.util.nodes import nested_parse_with_titles
 
 import tumble
 
@@ -153,8 +154,9 @@ def _example_title(app, docname, source):
 
 
 def _reread_the_user_guide(app, env, added, changed, removed):
-    """A page added or removed changes the user guide's toctree (an incremental build)."""
-    return ["user-guide"] if added or removed else []
+    """A page added or removed changes the user guide's toctree (an incremental build); the
+    API index lists the modules without a page, which no page's change announces."""
+    return ["user-guide", "api/index"] if added or removed else ["api/index"]
 
 
 def _constants_without_docstring(module_name: str) -> list[str]:
@@ -251,6 +253,47 @@ class TumbleConstants(Directive):
         return container.children
 
 
+def public_modules() -> list[str]:
+    """tumble's public modules, and those of a package that exports nothing itself (viz).
+
+    The command line (``tumble.cli``) is documented by docs/command-line.md instead.
+    """
+    found = []
+    for info in pkgutil.iter_modules(tumble.__path__, "tumble."):
+        if info.name.startswith("tumble._") or info.name == "tumble.cli":
+            continue
+        found.append(info.name)
+        module = importlib.import_module(info.name)
+        if info.ispkg and not getattr(module, "__all__", None):
+            found += [
+                sub.name
+                for sub in pkgutil.iter_modules(module.__path__, f"{info.name}.")
+                if not sub.name.rpartition(".")[2].startswith("_")
+            ]
+    return sorted(found)
+
+
+class OtherModules(Directive):
+    """``.. tumble-other-modules::``: a section for each public module no API page names.
+
+    A module added on another branch is then documented (at the end of the API index) until
+    it is given its place, instead of missing from the reference.
+    """
+
+    def run(self):
+        pages = "\n".join(page.read_text() for page in (HERE / "api").glob("*.rst"))
+        placed = set(re.findall(r"^\.\. automodule:: ([\w.]+)$", pages, re.MULTILINE))
+        lines = []
+        for name in [name for name in public_modules() if name not in placed]:
+            lines = lines or [".. rubric:: Modules not yet on a page of their own", ""]
+            title = f"``{name}``"
+            lines += [title, "-" * len(title), "", f".. automodule:: {name}", ""]
+            lines += [f".. tumble-constants:: {name}", ""]
+        container = nodes.container()
+        nested_parse_with_titles(self.state, StringList(lines, "other-modules"), container)
+        return container.children
+
+
 class TumbleNames(Directive):
     """``.. tumble-names::``: a list of ``tumble.__all__``, each linked where it is documented."""
 
@@ -278,3 +321,4 @@ def setup(app):
     app.connect("autodoc-process-docstring", _escape_bars, priority=401)
     app.add_directive("tumble-names", TumbleNames)
     app.add_directive("tumble-constants", TumbleConstants)
+    app.add_directive("tumble-other-modules", OtherModules)
