@@ -301,7 +301,7 @@ class TumbleNames(Directive):
         lines = []
         for name in tumble.__all__:
             if name in tumble._SUBMODULES:
-                lines.append(f"* :mod:`tumble.{name}` — :doc:`{name}`")
+                lines.append(f"* :mod:`tumble.{name}`")
             else:
                 lines.append(f"* :obj:`tumble.{name} <{tumble._NAMES[name]}.{name}>`")
         container = nodes.container()
