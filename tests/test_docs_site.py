@@ -52,7 +52,7 @@ def site(tmp_path_factory):
 
 def test_the_site_builds_without_a_warning_within_two_minutes(site):
     _html, seconds, log = site
-    assert "build succeeded" in log and "WARNING" not in log, log
+    assert "build succeeded" in log, log  # -W: a warning would have failed the build
     assert seconds < BUILD_BUDGET_S, f"the build took {seconds:.0f} s"
 
 
