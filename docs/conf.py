@@ -53,7 +53,7 @@ suppress_warnings = ["ref.citation"]
 # API: numpydoc renders the docstrings; signatures without type hints (the Parameters say it).
 autodoc_typehints = "none"
 autodoc_member_order = "bysource"
-autodoc_default_options = {"members": True, "show-inheritance": False}
+autodoc_default_options = {"members": True}
 numpydoc_show_class_members = False  # the class body is documented by autodoc itself
 numpydoc_class_members_toctree = False
 numpydoc_validation_checks: set[str] = set()  # validated by review, not by the build
