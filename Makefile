@@ -8,7 +8,7 @@ BENCH_STAMP := $(VENV)/.installed-bench
 DEMO ?= t-handle
 RUN_DIR ?= runs/$(DEMO)
 
-.PHONY: demo test browser bench lint format clean
+.PHONY: demo test browser bench lint format clean docs
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -39,6 +39,10 @@ bench: $(BENCH_STAMP)
 	@dpkg -s libblas3 liblapack3 >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -q libblas3 liblapack3) \
 		|| echo "note: libblas3/liblapack3 missing; the OpenSees columns will be skipped"
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/run_all.py
+
+# The documentation site (Sphinx, docs/conf.py) in build/docs/html/index.html; warnings are errors.
+docs: $(STAMP)
+	$(BIN)/sphinx-build -W --keep-going -b html -d build/docs/doctrees docs build/docs/html
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -16,7 +16,7 @@ cylinder a, L      m a² / 2                    m (3 a² + L²) / 12
 hex prism a, L     5 m a² / 12                 m (5 a² / 24 + L² / 12)
 torus R, r         m (R² + 3 r² / 4)           m (R² / 2 + 5 r² / 8)
 sphere a           2 m a² / 5                  2 m a² / 5
-box (a, b, c)      I_x = m (b² + c²) / 12, and cyclically
+box (a, b, c)      I_x = m (b² + c²) / 12      and cyclically: I_y, I_z
 =================  ==========================  ==================================
 
 The hexagonal prism (circumradius ``a`` = side) follows from six equilateral triangles:
@@ -38,7 +38,7 @@ from tumble import _checks
 from tumble.so3 import validate_rotation
 
 SYMMETRY_RTOL = 1e-9
-"""Allowed |I - Iᵀ| relative to max |I| before an inertia is refused as not symmetric."""
+"""Allowed ‖I − Iᵀ‖ relative to max ‖I‖ before an inertia is refused as not symmetric."""
 TRIANGLE_RTOL = 1e-9
 """Allowed violation of I_a + I_b >= I_c, relative to the largest principal moment."""
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
