@@ -13,6 +13,10 @@ Time stepping
     (``t``, ``x``, ``y``, ``energy``, ``tip_displacement``). The step matrix is factorised
     once, banded Cholesky or sparse LU by its band (:mod:`tumble.structural.factorization`),
     and the loop runs compiled (:mod:`tumble.structural.stepping`).
+Exact reference
+    :func:`exact_response` — the motion of a linear system by modal superposition
+    (:class:`ModalSolution`), at any time, with Rayleigh damping: the yardstick of every
+    scheme's error.
 Stability
     :func:`critical_dt` (a :class:`CriticalStep`: the step, ``ω_max`` and whether that mode
     is axial or bending), :func:`stability_sweep` (energy growth per dt),
@@ -44,6 +48,7 @@ from tumble.structural.assembly import (
     cantilever,
     condition_estimate,
 )
+from tumble.structural.modal import ModalSolution, exact_response
 from tumble.structural.schemes import (
     EXPLICIT,
     IMPLICIT,
@@ -79,6 +84,7 @@ __all__ = [
     "FrameElements",
     "IllConditionedWarning",
     "LinearSystem",
+    "ModalSolution",
     "Newmark",
     "RayleighDamping",
     "Response",
@@ -90,6 +96,7 @@ __all__ = [
     "critical_dt",
     "elements",
     "energy_scale",
+    "exact_response",
     "integrate",
     "stability_sweep",
 ]
