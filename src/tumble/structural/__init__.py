@@ -41,6 +41,7 @@ array([52.4971])
 """
 
 from tumble.structural import elements
+from tumble.structural.alpha import HHT, Bathe, GeneralizedAlpha
 from tumble.structural.assembly import (
     SUPPORT_KINDS,
     IllConditionedWarning,
@@ -48,7 +49,7 @@ from tumble.structural.assembly import (
     cantilever,
     condition_estimate,
 )
-from tumble.structural.modal import ModalSolution, exact_response
+from tumble.structural.modal import ModalSolution, exact_response, modal_energies
 from tumble.structural.schemes import (
     EXPLICIT,
     IMPLICIT,
@@ -80,8 +81,11 @@ __all__ = [
     "SEED_SCHEMES",
     "SEMI_IMPLICIT",
     "SUPPORT_KINDS",
+    "Bathe",
     "CriticalStep",
     "FrameElements",
+    "GeneralizedAlpha",
+    "HHT",
     "IllConditionedWarning",
     "LinearSystem",
     "ModalSolution",
@@ -98,5 +102,6 @@ __all__ = [
     "energy_scale",
     "exact_response",
     "integrate",
+    "modal_energies",
     "stability_sweep",
 ]

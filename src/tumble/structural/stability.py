@@ -34,6 +34,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from tumble import _checks
+from tumble.structural.alpha import AlphaScheme, Bathe
 from tumble.structural.schemes import Newmark, Scheme, integrate, resolve_scheme
 from tumble.structural.system import DENSE_EIGEN_LIMIT, LinearSystem
 
@@ -108,6 +109,8 @@ def critical_dt(system: LinearSystem, scheme: str | Scheme) -> CriticalStep:
 
 def _critical_z(scheme: Scheme) -> float:
     """Largest stable ``ω Δt`` of a scheme (0: never stable; inf: always)."""
+    if isinstance(scheme, AlphaScheme | Bathe):  # refused unless unconditionally stable
+        return math.inf
     if isinstance(scheme, Newmark):
         beta, gamma = scheme.beta, scheme.gamma
         if gamma < 0.5:
