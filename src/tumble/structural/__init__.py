@@ -21,6 +21,11 @@ Stability
     :func:`critical_dt` (a :class:`CriticalStep`: the step, ``ω_max`` and whether that mode
     is axial or bending), :func:`stability_sweep` (energy growth per dt),
     :func:`energy_scale`.
+Time-step analysis
+    :func:`amplification` — each scheme's amplification matrix on the oscillator against
+    ``Ω = ωΔt``: spectral radius, algorithmic damping, period elongation, critical Ω
+    (:class:`Amplification`); :func:`mode_table` — every mode of a system at one Δt
+    (:class:`ModeTable`).
 Elements
     :mod:`tumble.structural.elements` — element stiffness, consistent mass and internal
     forces as pure functions.
@@ -42,6 +47,7 @@ array([52.4971])
 
 from tumble.structural import elements
 from tumble.structural.alpha import HHT, Bathe, GeneralizedAlpha
+from tumble.structural.amplification import Amplification, ModeTable, amplification, mode_table
 from tumble.structural.assembly import (
     SUPPORT_KINDS,
     IllConditionedWarning,
@@ -73,6 +79,10 @@ from tumble.structural.stability import (
 from tumble.structural.system import FrameElements, LinearSystem, RayleighDamping
 
 __all__ = [
+    "Amplification",
+    "ModeTable",
+    "amplification",
+    "mode_table",
     "EXPLICIT",
     "IMPLICIT",
     "MIDPOINT",
