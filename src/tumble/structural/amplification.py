@@ -160,7 +160,7 @@ def amplification(scheme: str | Scheme, omega: ArrayLike, xi: float = 0.0) -> Am
     >>> out.spectral_radius.round(12), bool(np.all(np.abs(out.damping_ratio) < 1e-12))
     (array([1., 1., 1.]), True)
     >>> float(out.period_elongation[1].round(6))   # Ω/(2 atan(Ω/2)) − 1
-    0.078343
+    0.078405
     >>> amplification("semi-implicit", [1.0]).critical_omega
     2.0
     """
@@ -232,7 +232,7 @@ def mode_table(
     >>> table = mode_table(beam, 1e-3, ("newmark", "bathe"), n_modes=2)
     >>> (table.omega * table.dt).round(3)
     array([0.052, 0.329])
-    >>> bool(table.damping_ratio[0, 1] == 0.0), bool(table.damping_ratio[1, 1] > 0)
+    >>> bool(abs(table.damping_ratio[0, 1]) < 1e-12), bool(table.damping_ratio[1, 1] > 0)
     (True, True)
     """
     from tumble.structural.schemes import SCHEMES
