@@ -19,16 +19,6 @@ from tumble.structural.kernels import assemble_internal_forces_pair, banded_solv
 
 
 @numba.njit(cache=True, nogil=True)
-def _minus_damping(q, y, indptr, indices, data, i):  # noqa: ANN001, ANN202
-    """``q[i] − (C y)[i]`` (``q[i]`` when ``C`` is absent: ``indptr`` empty)."""
-    r = q[i]
-    if indptr.size:
-        for j in range(indptr[i], indptr[i + 1]):
-            r -= data[j] * y[indices[j]]
-    return r
-
-
-@numba.njit(cache=True, nogil=True)
 def run_alpha_steps(
     first: int,
     last: int,
@@ -56,6 +46,7 @@ def run_alpha_steps(
     indptr, indices, data = damping
     n = x.size
     diverged = -1
+    damped = indptr.size > 0
     for k in range(first + 1, last + 1):
         for i in range(n):
             rhs[i] = dt * (c_r * r[i] + (1.0 - c_r) * m[i] - p[i])
@@ -73,8 +64,11 @@ def run_alpha_steps(
         assemble_internal_forces_pair(rhs, combined, *frame, sdx, p)  # type: ignore[call-arg]
         for i in range(n):
             q[i] -= sdx[i]
-        for i in range(n):
-            r_new = _minus_damping(q, y, indptr, indices, data, i)
+        for i in range(n):  # r = q − C y, then m from the equation of motion
+            r_new = q[i]
+            if damped:
+                for j in range(indptr[i], indptr[i + 1]):
+                    r_new -= data[j] * y[indices[j]]
             m[i] = m_new * r_new + m_old * r[i] - m_prev * m[i]
             r[i] = r_new
         if non_finite or k == record_steps[row]:
@@ -116,9 +110,13 @@ def run_bathe_steps(
     indptr, indices, data = damping
     n = x.size
     diverged = -1
+    damped = indptr.size > 0
     for k in range(first + 1, last + 1):
-        for i in range(n):  # trapezoidal sub-step over τ
-            r_old[i] = _minus_damping(q, y, indptr, indices, data, i)
+        for i in range(n):  # trapezoidal sub-step over τ; r = q − C y
+            r_old[i] = q[i]
+            if damped:
+                for j in range(indptr[i], indptr[i + 1]):
+                    r_old[i] -= data[j] * y[indices[j]]
             y_old[i] = y[i]
             g_old[i] = g[i]
             rhs[i] = tau * (r_old[i] - 0.5 * tau * g[i])
@@ -132,7 +130,10 @@ def run_bathe_steps(
         for i in range(n):
             q[i] -= sdx[i]
         for i in range(n):  # the second sub-step, to t + Δt
-            r_mid = _minus_damping(q, y, indptr, indices, data, i)
+            r_mid = q[i]
+            if damped:
+                for j in range(indptr[i], indptr[i + 1]):
+                    r_mid -= data[j] * y[indices[j]]
             rhs[i] = dt * (d0 * r_old[i] + d1 * r_mid - q2 * dt * (d0 * g_old[i] + d1 * g[i]))
             y_old[i] = d0 * y_old[i] + d1 * y[i]
         banded_solve(second_factor[0], second_factor[1], second_factor[2], rhs, second_factor[3])
