@@ -31,6 +31,7 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -71,16 +72,24 @@ def _step_matrix(scheme: Scheme, omega: float, xi: float) -> NDArray:
     for x, y in np.eye(2):
         state = State.start(system, np.array([x]), np.array([y]))
         if isinstance(scheme, Bathe):
-            pivots = [float(A[0, 0]) for A in scheme.matrices(system, C, 1.0)]
-            solves = [lambda b, p=p: b / p for p in pivots]
+            solves = [_divide_by(float(A[0, 0])) for A in scheme.matrices(system, C, 1.0)]
             bathe_step(state, scheme.coefficients(1.0), system, solves, C)
         else:
-            pivot = float(scheme.matrix(system, C, 1.0)[0, 0])
             k = scheme.increments(1.0)
-            mass = (lambda b: b) if k.mass_solve else None
-            reference_step(state, k, system, lambda b, p=pivot: b / p, mass, C)
+            mass = _identity if k.mass_solve else None
+            solve = _divide_by(float(scheme.matrix(system, C, 1.0)[0, 0]))
+            reference_step(state, k, system, solve, mass, C)
         columns.append([state.x[0], state.y[0]])
     return np.array(columns).T
+
+
+def _identity(b: NDArray) -> NDArray:
+    return b
+
+
+def _divide_by(pivot: float) -> Callable[[NDArray], NDArray]:
+    """The solve with the 1 × 1 step matrix ``[pivot]``."""
+    return lambda b: b / pivot
 
 
 def _alpha_matrix(scheme: AlphaScheme, system: Any) -> NDArray:
@@ -95,7 +104,7 @@ def _alpha_matrix(scheme: AlphaScheme, system: Any) -> NDArray:
         r = q - (0.0 if C is None else C @ [y])
         p = system.stiffness * np.array([k_g * y + k_sa * a])
         state = AlphaState(np.array([x]), np.array([y]), q, p, np.array([a]), np.array([a]), r)
-        alpha_step(state, values, system, lambda b: b / pivot, C)
+        alpha_step(state, values, system, _divide_by(pivot), C)
         columns.append([state.x[0], state.y[0], state.a[0]])
     return np.array(columns).T
 
