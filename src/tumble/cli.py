@@ -352,7 +352,7 @@ def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool)
 
     from tumble import structural
     from tumble.viz._figure import save
-    from tumble.viz.amplification import amplification_figure
+    from tumble.viz.amplification import amplification_figure, comparison_figure
 
     with _reported():
         system = structural.cantilever(1.0, n_elements, 210e9, 7850.0, 0.01, 0.01, 1.0)
@@ -366,6 +366,17 @@ def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool)
     folder.mkdir(parents=True, exist_ok=True)
     save(amplification_figure(analyses, title="amplification on ẍ + ω²x = 0 (SCHEMES' defaults)"),
          path, dpi=110)  # fmt: skip
+    period = 2 * np.pi / table.omega[0]
+    with _reported():
+        runs = {name: structural.integrate(system, s, period / 100, n_steps=500, record_every=2)
+                for name, s in structural.SCHEMES.items()
+                if structural.critical_dt(system, s).dt > period / 100}  # fmt: skip
+        exact = structural.exact_response(system, next(iter(runs.values())).t)
+    title = (f"{n_elements}-element cantilever, 1 N step load from rest, Δt = T₁/100, "
+             "against exact_response")  # fmt: skip
+    save(comparison_figure(system, runs, exact, title=title), folder / "schemes_vs_exact.png",
+         dpi=110)  # fmt: skip
+
     for name, values in (("algorithmic damping ratio ξ̄", table.damping_ratio),
                          ("period elongation (T̄ − T)/T", table.period_elongation)):  # fmt: skip
         grid = Table(title=f"{name}, cantilever with {n_elements} elements, Δt = {step:.4g} s "
@@ -379,7 +390,7 @@ def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool)
             ]
             grid.add_row(str(k + 1), f"{w:.4g}", f"{w * step:.3g}", *cells)
         console.print(grid)
-    console.print(f"plot: {path}", highlight=False)
+    console.print(f"plots: {path}, {folder / 'schemes_vs_exact.png'}", highlight=False)
 
 
 @app.command()

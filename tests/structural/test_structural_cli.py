@@ -15,6 +15,7 @@ def test_stability_analyse_writes_the_picture_and_tables_every_mode(tmp_path):
     )
     assert result.exit_code == 0, result.output
     assert (out / "amplification.png").stat().st_size > 10_000
+    assert (out / "schemes_vs_exact.png").stat().st_size > 10_000
     assert "algorithmic damping ratio" in result.output and "period elongation" in result.output
     beam = structural.cantilever(1.0, 4, 210e9, 7850.0, 0.01, 0.01)
     # every mode is a row, with its Ω = ωΔt; the explicit scheme grows in every mode
