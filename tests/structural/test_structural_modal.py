@@ -91,11 +91,16 @@ def test_impulse_response_solves_the_damped_oscillator(zeta):
     np.testing.assert_allclose(dh, expected[:, 1], rtol=0, atol=1e-11)
 
 
-@pytest.mark.parametrize("n_elements", [160, 640, 1280])
+@pytest.mark.parametrize("n_elements", [160, 640, 1280, 5000])
 def test_lowest_frequency_keeps_full_relative_accuracy_on_fine_meshes(n_elements):
-    beam = structural.cantilever(1.0, n_elements, **STEEL)
-    # the assembled S lost ε κ(S): 3.1e-9, 7.6e-6, 7.0e-6 before (issue 18, item 6);
-    # the element factor S = GᵀG: 1.1e-11 (the discretisation error, 1.3e-11), 4e-13, 1.4e-12
+    if n_elements > 3700:  # the builder warns for static and stepped results from here
+        with pytest.warns(structural.IllConditionedWarning):
+            beam = structural.cantilever(1.0, n_elements, **STEEL)
+    else:
+        beam = structural.cantilever(1.0, n_elements, **STEEL)
+    # the assembled S lost ε κ(S): 3.1e-9, 7.6e-6, 7.0e-6, 6.4e-8 before (issue 18, item 6);
+    # the element factor S = GᵀG: 1.1e-11 (the discretisation error, 1.3e-11), 1.5e-13,
+    # 3e-14, 8.6e-12
     error = abs(beam.natural_frequencies(1)[0] / OMEGA_1 - 1)
     assert error < 3e-11, error
 
