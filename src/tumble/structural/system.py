@@ -204,9 +204,9 @@ class LinearSystem:
         Measured on that cantilever against the exact roots of ``cos βL cosh βL = −1``
         (discretisation error included): mode 1 within 9e-13 at 320 elements, 1.5e-13 at
         640, 3e-14 at 1280, 2.3e-13 at 2560, 8.6e-12 at 5000, 9.5e-11 at 10⁴ and 4.8e-9 at
-        2·10⁴ (before: 8.5e-7, 7.6e-6, 7.0e-6, 8.7e-6, 6.4e-8, 3.1e-6, 8.2e-4). Past about 3700 elements the builder warns
-        (:class:`~tumble.structural.IllConditionedWarning`) for the static and time-stepped
-        results; the frequencies hold longer.
+        2·10⁴ (before: 8.5e-7, 7.6e-6, 7.0e-6, 8.7e-6, 6.4e-8, 3.1e-6, 8.2e-4). Past about
+        3700 elements the builder warns (:class:`~tumble.structural.IllConditionedWarning`)
+        for the static and time-stepped results; the frequencies hold longer.
 
         Returns
         -------
