@@ -42,7 +42,7 @@ from numpy.typing import ArrayLike, NDArray
 from tumble import _checks
 from tumble.structural.alpha import AlphaScheme, AlphaState, Bathe, alpha_step, bathe_step
 from tumble.structural.schemes import Scheme, resolve_scheme
-from tumble.structural.stability import _critical_z
+from tumble.structural.stability import critical_omega
 from tumble.structural.stepping import State, reference_step
 from tumble.structural.system import LinearSystem
 
@@ -189,7 +189,7 @@ def amplification(scheme: str | Scheme, omega: ArrayLike, xi: float = 0.0) -> Am
         damping = -np.log(np.abs(principal) ** 2) / (2 * omega_bar)
         elongation = omega / omega_bar - 1
     return Amplification(scheme.name, omega, xi, G, radius, damping, elongation,
-                         float(_critical_z(scheme)))  # fmt: skip
+                         float(critical_omega(scheme)))  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)

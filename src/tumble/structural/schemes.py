@@ -40,6 +40,13 @@ narrow (every beam, and every frame numbered along its members or renumbered by 
 Cuthill–McKee), sparse LU otherwise (:mod:`tumble.structural.factorization`) — and with the
 banded factor runs the whole time loop compiled (:func:`tumble.structural.kernels.run_steps`).
 
+Three schemes with controllable numerical damping join them in :data:`SCHEMES`, written in
+the same increments with their own compiled loops (:mod:`tumble.structural.alpha`):
+``hht`` (:class:`~tumble.structural.alpha.HHT`), ``generalized-alpha``
+(:class:`~tumble.structural.alpha.GeneralizedAlpha`, by ρ∞) and ``bathe``
+(:class:`~tumble.structural.alpha.Bathe`, the ρ∞-Bathe composite). Every scheme declares its
+``order`` (the tests measure it against :func:`~tumble.structural.exact_response`).
+
 References
 ----------
 .. [1] Ł. Łaniewski-Wołłk, *Metody Numeryczne, Instrukcja 5: Równania ruchu* (seed 003).
@@ -274,9 +281,11 @@ def integrate(
     ----------
     system : LinearSystem
         From :func:`~tumble.structural.cantilever` or :func:`~tumble.structural.build_frame`.
-    scheme : str or ThetaScheme or Newmark
-        ``"explicit"``, ``"semi-implicit"``, ``"implicit"``, ``"midpoint"``, ``"newmark"``,
-        or e.g. ``Newmark(beta=0.3025, gamma=0.6)``.
+    scheme : str or scheme object
+        A name from :data:`SCHEMES` (``"explicit"``, ``"semi-implicit"``, ``"implicit"``,
+        ``"midpoint"``, ``"newmark"``, ``"hht"``, ``"generalized-alpha"``, ``"bathe"``), or
+        a scheme with its parameters, e.g. ``Newmark(beta=0.3025, gamma=0.6)``,
+        ``GeneralizedAlpha(rho_inf=0.5)`` (:mod:`tumble.structural.alpha`).
     dt : float
         Time step [s], > 0.
     n_steps, t_end : int or float
