@@ -1,5 +1,6 @@
 """``tumble stability --analyse``: the amplification picture and the per-mode tables."""
 
+import numpy as np
 from typer.testing import CliRunner
 
 from tumble import structural
@@ -35,3 +36,19 @@ def test_stability_analyse_refuses_to_overwrite_without_force(tmp_path):
 def test_stability_analyse_refuses_a_bad_time_step(tmp_path):
     result = runner.invoke(app, ["stability", "--analyse", "--dt", "-1", "--out", str(tmp_path)])
     assert result.exit_code == 2 and "dt=-1.0 is not allowed" in result.output
+
+
+def test_amplification_figure_draws_every_scheme_on_log_axes():
+    from tumble.viz.amplification import amplification_figure
+
+    omega = 2 * np.pi * np.logspace(-2, 2, 21)
+    analyses = [structural.amplification(s, omega) for s in structural.SCHEMES]
+    fig = amplification_figure(analyses, title="t")
+    axes = fig.get_axes()
+    assert len(axes) == 3 and all(ax.get_xscale() == "log" for ax in axes)
+    for ax in axes:
+        assert [
+            line.get_label() for line in ax.get_lines() if not line.get_label().startswith("_")
+        ] == list(structural.SCHEMES)
+    # the legend names every scheme once
+    assert [t.get_text() for t in fig.legends[0].get_texts()] == list(structural.SCHEMES)
