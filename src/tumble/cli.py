@@ -309,10 +309,12 @@ def stability(
         ),
     ] = False,
     dt: Annotated[
-        float | None, typer.Option(help="Time step [s] of --analyse's mode table (default T₁/20).")
+        float | None,
+        typer.Option(help="Time step in s of --analyse's mode table (default T₁/20)."),
     ] = None,
 ) -> None:
-    """The cantilever's time-step sweep: which scheme stays bounded at which Δt."""
+    """The cantilever's time-step sweep: which scheme stays bounded at which Δt (with
+    --analyse: each scheme's amplification against Δt/T and the beam's modes under it)."""
     from tumble.scenarios import beam
 
     if analyse:
