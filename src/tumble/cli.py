@@ -299,10 +299,27 @@ def stability(
     steps: Annotated[int, typer.Option(help="Steps per run of the sweep.")] = 1000,
     out: Out = None,
     force: Force = False,
+    analyse: Annotated[
+        bool,
+        typer.Option(
+            "--analyse",
+            help="Instead of the sweep, the time-step analyser: amplification.png (spectral "
+            "radius, algorithmic damping and period error against Δt/T for every scheme) and "
+            "the beam's modes at --dt under each scheme.",
+        ),
+    ] = False,
+    dt: Annotated[
+        float | None,
+        typer.Option(help="Time step in s of --analyse's mode table (default T₁/20)."),
+    ] = None,
 ) -> None:
-    """The cantilever's time-step sweep: which scheme stays bounded at which Δt."""
+    """The cantilever's time-step sweep: which scheme stays bounded at which Δt (with
+    --analyse: each scheme's amplification against Δt/T and the beam's modes under it)."""
     from tumble.scenarios import beam
 
+    if analyse:
+        _analyse_steps(n_elements, dt, out or Path("runs") / "stability-analysis", force)
+        return
     with _reported(), _progress("stability sweep") as note:
         result = beam.stability(n_elements=n_elements, sweep_steps=steps)
         folder = _write(result, out or Path("runs") / "stability", force, False, note)
@@ -322,6 +339,60 @@ def stability(
         table.add_row(f"{factor:g}", f"{dt:.3g}", *cells)
     console.print(table)
     console.print(f"plot: {folder / 'stability_sweep.png'}", highlight=False)
+
+
+def _mode_cell(radius: float, value: float) -> str:
+    """A cell of the per-mode table: 'grows' where ρ > 1, '—' where there is no period."""
+    if radius > 1 + 1e-12:
+        return "[red]grows[/]"
+    return "—" if value != value else f"{abs(value) if abs(value) < 5e-4 else value:.3f}"
+
+
+def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool) -> None:
+    """``tumble stability --analyse``: the amplification picture and the per-mode tables."""
+    import numpy as np
+
+    from tumble import structural
+    from tumble.viz._figure import save
+    from tumble.viz.amplification import amplification_figure, comparison_figure
+
+    with _reported():
+        system = structural.cantilever(1.0, n_elements, 210e9, 7850.0, 0.01, 0.01, 1.0)
+        step = dt if dt is not None else 2 * np.pi / system.natural_frequencies(1)[0] / 20
+        table = structural.mode_table(system, step)
+        omega = 2 * np.pi * np.logspace(-2, 3, 241)
+        analyses = [structural.amplification(s, omega) for s in structural.SCHEMES.values()]
+    path = folder / "amplification.png"
+    if path.exists() and not force:
+        raise _fail(f"{path} exists; pass --force to overwrite it")
+    folder.mkdir(parents=True, exist_ok=True)
+    save(amplification_figure(analyses, title="amplification on ẍ + ω²x = 0 (SCHEMES' defaults)"),
+         path, dpi=110)  # fmt: skip
+    period = 2 * np.pi / table.omega[0]
+    with _reported():
+        runs = {name: structural.integrate(system, s, period / 100, n_steps=500, record_every=2)
+                for name, s in structural.SCHEMES.items()
+                if structural.critical_dt(system, s).dt > period / 100}  # fmt: skip
+        exact = structural.exact_response(system, next(iter(runs.values())).t)
+    title = (f"{n_elements}-element cantilever, 1 N step load from rest, Δt = T₁/100, "
+             "against exact_response")  # fmt: skip
+    save(comparison_figure(system, runs, exact, title=title), folder / "schemes_vs_exact.png",
+         dpi=110)  # fmt: skip
+
+    for name, values in (("algorithmic damping ratio ξ̄", table.damping_ratio),
+                         ("period elongation (T̄ − T)/T", table.period_elongation)):  # fmt: skip
+        grid = Table(title=f"{name}, cantilever with {n_elements} elements, Δt = {step:.4g} s "
+                     "(—: no period, the mode is damped out within a step)", box=None)  # fmt: skip
+        for column in ("mode", "ω [rad/s]", "Ω = ωΔt", *table.schemes):
+            grid.add_column(column.replace("-", "- "), justify="right", overflow="fold")
+        for k, w in enumerate(table.omega):
+            cells = [
+                _mode_cell(radius[k], v[k])
+                for radius, v in zip(table.spectral_radius, values, strict=True)
+            ]
+            grid.add_row(str(k + 1), f"{w:.4g}", f"{w * step:.3g}", *cells)
+        console.print(grid)
+    console.print(f"plots: {path}, {folder / 'schemes_vs_exact.png'}", highlight=False)
 
 
 @app.command()
