@@ -1,0 +1,167 @@
+"""``sweep``: check, connect, write the template, run the tasks on Dask, return the dataset."""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Callable, Mapping, Sequence
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Any
+
+from tumble import _checks
+from tumble.sweeps.members import run_members
+from tumble.sweeps.plan import Plan, make_plan
+from tumble.sweeps.store import check_existing, pending_tasks, write_region, write_template
+
+log = logging.getLogger(__name__)
+
+CONNECT_TIMEOUT = 10.0
+"""Seconds to wait for a scheduler address to answer before giving up (``timeout``)."""
+
+
+def run_task(plan: Plan, store: str, task: tuple[int, ...]) -> int:
+    """Run one task's members and write its region (what a Dask worker runs).
+
+    Returns the number of members written. Writing the same task twice writes the same
+    numbers (a task is rerun when its worker dies), so a retried task is harmless.
+    """
+    region = plan.region(task)
+    ranges = [range(s.start, s.stop) for s in region.values()]
+    import itertools
+
+    indices = list(itertools.product(*ranges))
+    write_region(plan, store, task, run_members(plan, indices))
+    return len(indices)
+
+
+def sweep(
+    scenario: Any,
+    grid: Mapping[str, Sequence] | None = None,
+    samples: Any = None,
+    *,
+    client: Any = None,
+    store: str | Path,
+    chunk: int | None = None,
+    resume: bool = False,
+    timeout: float = CONNECT_TIMEOUT,
+    progress: Callable[[int, int], None] | None = None,
+):
+    """Run a scenario over a grid (or a table) of options on Dask, into one Zarr store.
+
+    Each member is the scenario run with its options, :func:`tumble.rigid.simulate`'s
+    numbers bit for bit (members that differ only in their initial state run together through
+    :func:`tumble.rigid.simulate_batch`). The members are cut into tasks of ``chunk``
+    members; each task writes its own region of the store, then its completion flags
+    (:mod:`tumble.sweeps.store`).
+
+    Parameters
+    ----------
+    scenario : str, Path, mapping or tumble.scenarios.rigid_body.Options
+        A ``rigid-body`` scenario file (``.toml``), or its options.
+    grid : mapping of str to sequence, optional
+        Dotted option path → values (``{"omega0.1": [0.01, 0.02], "method": ["rkmk4"]}``);
+        the values multiply and each path is a dimension of the output
+        (:mod:`tumble.sweeps.plan`).
+    samples : mapping of str to sequence, rows, or DataFrame, optional
+        One member per row along a ``member`` dimension (a Monte Carlo), instead of ``grid``.
+    client : distributed.Client, str or None
+        A client; a scheduler's address (``"tcp://127.0.0.1:8786"``); or None for a
+        ``LocalCluster`` of one single-threaded worker process per core.
+    store : str or Path
+        The Zarr store (a folder) to write.
+    chunk : int, optional
+        Members per task (default: about 64 MB of output, at most 4096 members).
+    resume : bool
+        Complete an existing store of the same sweep: members already done are skipped. An
+        existing store without ``resume`` is refused.
+    timeout : float
+        Seconds to wait for a scheduler address to answer.
+    progress : callable, optional
+        ``progress(members_done, members_total)`` after each task.
+
+    Returns
+    -------
+    xarray.Dataset
+        The store, opened with ``xr.open_zarr`` (lazy).
+
+    Raises
+    ------
+    ValueError
+        Before any work: an unknown option path, a bad value, an empty grid, an existing store
+        without ``resume`` (or of another sweep), a scheduler address that does not answer
+        within ``timeout``.
+    """
+    import xarray as xr
+    from distributed import as_completed
+
+    plan = make_plan(scenario, grid, samples, chunk=chunk)
+    store = str(store)
+    exists = Path(store).exists()
+    if exists and not resume:
+        raise _checks.fail(
+            "store", store, "a path that does not exist yet",
+            remedy="pass resume=True (--resume) to complete it, or choose another store",
+        )  # fmt: skip
+    if exists:
+        check_existing(plan, store)
+    with _client(client, timeout) as dask_client:
+        if not exists:
+            write_template(plan, store)
+        tasks = pending_tasks(plan, store) if exists else plan.tasks()
+        done = plan.size - sum(_members(plan, task) for task in tasks)
+        log.info("sweep: %d members in %d tasks to run, %d done", plan.size - done,
+                 len(tasks), done)  # fmt: skip
+        if progress is not None:
+            progress(done, plan.size)
+        shared = dask_client.scatter(plan, broadcast=True)
+        futures = [
+            dask_client.submit(run_task, shared, store, task, pure=False, key=_key(store, task))
+            for task in tasks
+        ]
+        for future in as_completed(futures):
+            done += future.result()
+            future.release()
+            if progress is not None:
+                progress(done, plan.size)
+    return xr.open_zarr(store)
+
+
+def _key(store: str, task: tuple[int, ...]) -> str:
+    return f"tumble-sweep-{abs(hash(store))}-" + "-".join(map(str, task))
+
+
+def _members(plan: Plan, task: tuple[int, ...]) -> int:
+    size = 1
+    for part in plan.region(task).values():
+        size *= part.stop - part.start
+    return size
+
+
+@contextmanager
+def _client(client: Any, timeout: float):
+    """The Dask client to use: the one given, one connected to an address, or a local one."""
+    from distributed import Client, LocalCluster
+
+    if client is not None and not isinstance(client, str):
+        yield client
+        return
+    if client is None:
+        workers = os.cpu_count() or 1
+        with (
+            LocalCluster(n_workers=workers, threads_per_worker=1, processes=True) as cluster,
+            Client(cluster) as local,
+        ):
+            yield local
+        return
+    seconds = _checks.positive("timeout", timeout, "s")
+    try:
+        connected = Client(client, timeout=seconds)
+    except (OSError, TimeoutError) as error:
+        raise _checks.fail(
+            "scheduler", client, "the address of a running Dask scheduler",
+            remedy=f"none answered within {seconds:g} s ({type(error).__name__}); start one "
+            "with `dask scheduler` and its workers with `dask worker ADDRESS`",
+        ) from None  # fmt: skip
+    with connected:
+        yield connected

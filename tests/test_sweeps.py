@@ -1,0 +1,177 @@
+"""tumble.sweep on a real LocalCluster of two worker processes: members, store, resume, refusals.
+
+Every member is compared with the scenario run alone (``rigid_body.run``, which calls
+``simulate``) with np.array_equal: bit for bit, not to a tolerance.
+"""
+
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+
+import tumble
+from tumble.rigid.batch import FIXED_METHODS
+from tumble.scenarios import rigid_body
+from tumble.sweeps import make_plan
+from tumble.sweeps.members import SERIES, SUMMARY
+from tumble.sweeps.store import write_region, write_template
+
+EXAMPLES = Path(__file__).parents[1] / "examples"
+BODY = {"shape": "box", "extents": [0.3, 0.2, 0.1], "mass": 2.0}
+"""A box with three distinct moments: its spin about y (intermediate) flips."""
+
+
+@pytest.fixture(scope="module")
+def client():
+    distributed = pytest.importorskip("distributed")
+    with (
+        distributed.LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0"
+        ) as cluster,
+        distributed.Client(cluster) as dask_client,
+    ):
+        yield dask_client
+
+
+def tiny(**options):
+    """A free box spun near its intermediate axis for 0.6 s."""
+    base = {"body": BODY, "initial": {"omega0": [0.1, 20.0, 0.1]}, "h": 0.01, "t_end": 0.6}
+    return {**base, **options}
+
+
+def alone(options: dict):
+    """The member's options run as the scenario runs them: one simulate call."""
+    return rigid_body.run(**options).data["trajectory"]
+
+
+def assert_member_equals(ds: xr.Dataset, where: dict, options: dict) -> None:
+    trajectory = alone(options)
+    member = ds.sel(where)
+    assert np.array_equal(ds["time"].values, trajectory.t)
+    for name in SERIES:
+        assert np.array_equal(member[name].values, getattr(trajectory, name)), (where, name)
+    assert int(member["status"]) == trajectory.status
+    assert int(member["n_steps"]) == trajectory.n_steps
+    assert int(member["done"]) == 1
+
+
+def test_members_equal_single_simulate_runs_bit_for_bit(client, tmp_path):
+    spins = [0.05, 3.0]
+    ds = tumble.sweep(
+        tiny(), {"omega0.2": spins, "method": FIXED_METHODS}, client=client,
+        store=tmp_path / "s.zarr", chunk=3,
+    )  # fmt: skip
+    for spin in spins:
+        for method in FIXED_METHODS:
+            options = tiny(method=method, initial={"omega0": [0.1, 20.0, spin]})
+            assert_member_equals(ds, {"omega0.2": spin, "method": method}, options)
+
+
+def test_members_with_an_impulse_equal_single_runs(client, tmp_path):
+    """An impulse cannot be batched: the task runs each member through simulate."""
+    kick = {"type": "impulse", "impulse": [0.0, 0.5, 6.0], "point": [0.05, 0.0, -0.05]}
+    gravity = {"type": "gravity", "g": [0.0, 0.0, -9.81]}
+    samples = {"impulse.impulse.2": [1.0, 4.0, 6.0], "method": ["rkmk4", "rkmk45", "rk4-quat"]}
+    base = tiny(loads=[gravity, kick], initial={}, rtol=None)
+    ds = tumble.sweep(base, samples=samples, client=client, store=tmp_path / "s.zarr")
+    assert "time" not in ds.dims  # rkmk45's steps are its own: no shared time axis
+    assert ds.attrs["series"].startswith("not stored")
+    for k, (push, method) in enumerate(zip(*samples.values(), strict=True)):
+        loads = [gravity, {**kick, "impulse": [0.0, 0.5, push]}]
+        trajectory = alone({**base, "loads": loads, "method": method})
+        member = ds.sel(member=k)
+        assert int(member["n_steps"]) == trajectory.n_steps
+        final = trajectory.energy[-1] / trajectory.energy[0] - 1
+        assert float(member["energy_error"]) == abs(final)
+
+
+def test_store_opens_as_one_dataset_with_the_documented_dimensions(client, tmp_path):
+    grid = {"omega0.1": [18.0, 20.0, 22.0]}
+    tumble.sweep(tiny(), grid, client=client, store=tmp_path / "s.zarr")
+    ds = xr.open_zarr(tmp_path / "s.zarr")
+    assert dict(ds.sizes) == {"omega0.1": 3, "time": 61, "axis": 3, "row": 3, "col": 3}
+    assert ds["R"].dims == ("omega0.1", "time", "row", "col")
+    assert ds["energy_error"].dims == ("omega0.1",)
+    assert ds["omega0.1"].attrs["option_path"] == "initial.omega0.1"
+    for name in [*SERIES, *SUMMARY]:
+        assert {"units", "long_name"} <= set(ds[name].attrs), name
+    assert json.loads(ds.attrs["grid"])["omega0.1"]["values"] == grid["omega0.1"]
+    assert ds.attrs["tumble_version"] == tumble.__version__
+    assert len(ds.attrs["scenario_sha256"]) == 64
+
+
+def test_flip_period_is_the_exact_period(client, tmp_path):
+    """The box spun near its intermediate axis: the measured period is the elliptic one."""
+    options = tiny(t_end=3.0, h=0.002)
+    spins = [0.2, 0.5]
+    ds = tumble.sweep(options, {"omega0.0": spins}, client=client, store=tmp_path / "s.zarr")
+    body = alone(options).body
+    for spin in spins:
+        exact = tumble.exact.free_body_period(body.inertia, [spin, 20.0, 0.1])
+        measured = float(ds["flip_period"].sel({"omega0.0": spin}))
+        assert abs(measured / exact - 1) < 1e-3, (spin, measured, exact)
+
+
+def test_resume_redoes_a_half_written_task_and_skips_done_ones(client, tmp_path):
+    store = tmp_path / "s.zarr"
+    grid = {"omega0.2": [0.1, 0.2, 0.3, 0.4]}
+    plan = make_plan(tiny(), grid, chunk=2)
+    write_template(plan, store)
+    first, second = plan.tasks()
+    # task 1 done, but with a marked wall time; task 2 half-written: data, no done flag
+    values = {name: np.full((2, 61, *(3,) * len(SERIES[name][0])), 7.0) for name in SERIES}
+    summary = {"status": np.zeros(2, "int8"), "n_steps": np.zeros(2, "int64")}
+    marked = {**values, **summary, "energy_error": np.zeros(2), "flip_period": np.zeros(2),
+              "wall_time": np.full(2, -1.0)}  # fmt: skip
+    write_region(plan, store, first, marked)
+    xr.Dataset({"x": (("omega0.2", "time", "axis"), values["x"])}).to_zarr(
+        store, region=plan.region(second), mode="r+"
+    )
+    ds = tumble.sweep(tiny(), grid, client=client, store=store, chunk=2, resume=True)
+    assert (ds["wall_time"].values[:2] == -1.0).all()  # done: not run again
+    for spin in grid["omega0.2"][2:]:
+        options = tiny(initial={"omega0": [0.1, 20.0, spin]})
+        assert_member_equals(ds, {"omega0.2": spin}, options)
+
+
+@pytest.mark.parametrize(
+    ("grid", "message"),
+    [
+        ({"omega9.1": [1.0]}, r"grid key 'omega9.1' is not an option path.*allowed: .*omega0"),
+        ({"omega0.1": ["fast"]}, r"grid key 'omega0.1', value 'fast'.*must be a number"),
+        ({"h": [-0.01]}, r"grid key 'h', value -0.01: options.h = -0.01: must be > 0"),
+        ({"omega0.3": [1.0]}, r"has 3 entries, so index 3 is not allowed: must be 0 to 2"),
+        ({"method": ["rk99"]}, r"value 'rk99'.*must be one of .*rkmk4"),
+        ({}, r"grid=\{\} is not allowed: must be a mapping of at least one option path"),
+        ({"h": []}, r"grid\['h'\]=\[\] is not allowed: must be a non-empty list"),
+    ],
+)
+def test_bad_grids_are_refused_before_any_work(tmp_path, grid, message):
+    store = tmp_path / "s.zarr"
+    with pytest.raises(ValueError, match=message):
+        tumble.sweep(tiny(), grid, client="tcp://127.0.0.1:1", store=store)
+    assert not store.exists()
+
+
+def test_an_existing_store_without_resume_is_refused(tmp_path):
+    store = tmp_path / "s.zarr"
+    store.mkdir()
+    with pytest.raises(ValueError, match=r"store=.* must be a path that does not exist yet; "
+                       r"pass resume=True"):  # fmt: skip
+        tumble.sweep(tiny(), {"h": [0.01]}, client="tcp://127.0.0.1:1", store=store)
+
+
+def test_a_silent_scheduler_address_is_refused_within_the_timeout(tmp_path):
+    start = time.perf_counter()
+    with pytest.raises(
+        ValueError,
+        match=r"scheduler='tcp://127.0.0.1:1' is not allowed: must "
+        r"be the address of a running Dask scheduler; none answered within 2 s",
+    ):
+        tumble.sweep(tiny(), {"h": [0.01]}, client="tcp://127.0.0.1:1", store=tmp_path / "s",
+                     timeout=2.0)  # fmt: skip
+    assert time.perf_counter() - start < 2.0 + 3.0  # the timeout and the client's start
+    assert not (tmp_path / "s").exists()
