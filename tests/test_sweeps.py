@@ -175,3 +175,59 @@ def test_a_silent_scheduler_address_is_refused_within_the_timeout(tmp_path):
                      timeout=2.0)  # fmt: skip
     assert time.perf_counter() - start < 2.0 + 3.0  # the timeout and the client's start
     assert not (tmp_path / "s").exists()
+
+
+# ---------------------------------------------------------------------------------------
+# The command line.
+
+
+def scenario_file(folder: Path) -> Path:
+    path = folder / "box.toml"
+    path.write_text(
+        'scenario = "rigid-body"\n[options]\nh = 0.01\nt_end = 0.6\n'
+        '[options.body]\nshape = "box"\nextents = [0.3, 0.2, 0.1]\nmass = 2.0\n'
+        "[options.initial]\nomega0 = [0.1, 20.0, 0.1]\n"
+        '[sweep.grid]\nomega0.0 = "0.1:0.3:3"\nmethod = ["rkmk4", "lie-euler"]\n'
+    )
+    return path
+
+
+def test_cli_sweeps_the_file_grid_and_draws_the_map(client, tmp_path):
+    from typer.testing import CliRunner
+
+    from tumble.cli import app
+
+    out = tmp_path / "runs" / "box.zarr"
+    args = ["sweep", str(scenario_file(tmp_path)), "--out", str(out), "--map", "energy_error"]
+    result = CliRunner().invoke(app, [*args, "--scheduler", client.scheduler.address])
+    assert result.exit_code == 0, result.output
+    assert "members                   6 (3 x 2)" in result.output
+    ds = xr.open_zarr(out)
+    assert ds["done"].values.all()
+    assert list(ds["method"].values) == ["rkmk4", "lie-euler"]
+    options = tiny(method="lie-euler", initial={"omega0": [0.2, 20.0, 0.1]})
+    assert_member_equals(ds, {"omega0.0": 0.2, "method": "lie-euler"}, options)
+    assert (tmp_path / "runs" / "box-energy_error.png").stat().st_size > 10_000
+    again = CliRunner().invoke(app, [*args, "--scheduler", client.scheduler.address])
+    assert again.exit_code == 2
+    assert "must be a path that does not exist yet; pass resume=True (--resume)" in again.output
+
+
+@pytest.mark.parametrize(
+    ("grid", "message"),
+    [
+        ("h", "--grid 'h': must be PATH=VALUES"),
+        ("h=0.01:0.1", "grid h='0.01:0.1' is not allowed: must be start:stop:count"),
+        ("omega0.x=1", "grid key 'omega0.x'"),
+    ],
+)
+def test_cli_refuses_a_bad_grid_with_exit_code_2(tmp_path, grid, message):
+    from typer.testing import CliRunner
+
+    from tumble.cli import app
+
+    args = ["sweep", str(scenario_file(tmp_path)), "--grid", grid, "--out", str(tmp_path / "s")]
+    result = CliRunner().invoke(app, [*args, "--scheduler", "tcp://127.0.0.1:1"])
+    assert result.exit_code == 2
+    assert message in result.output
+    assert not (tmp_path / "s").exists()

@@ -166,18 +166,87 @@ def dim_path(path: tuple) -> str:
 
 
 # ---------------------------------------------------------------------------------------
+# Values written as text (the command line, a file's [sweep.grid]).
+
+
+def parse_values(key: str, text: str) -> list:
+    """The values of ``--grid KEY=TEXT``: ``start:stop:count`` or ``a,b,c``.
+
+    ``start:stop:count`` is ``count`` evenly spaced numbers from ``start`` to ``stop``, both
+    included (``numpy.linspace``); ``a,b,c`` a list of numbers, ``true``/``false`` or names.
+
+    Examples
+    --------
+    >>> parse_values("omega0.1", "0.0:0.1:3")
+    [0.0, 0.05, 0.1]
+    >>> parse_values("method", "rkmk4,split-axes")
+    ['rkmk4', 'split-axes']
+    >>> parse_values("h", "0.01:0.1")
+    Traceback (most recent call last):
+    ...
+    ValueError: grid h='0.01:0.1' is not allowed: must be start:stop:count (numbers, count an integer >= 1) or a comma-separated list
+    """  # noqa: E501 - the doctest's message is one line
+    parts = text.split(":")
+    if len(parts) == 1:
+        return [_scalar(item.strip()) for item in text.split(",")]
+    allowed = "start:stop:count (numbers, count an integer >= 1) or a comma-separated list"
+    try:
+        start, stop, count = float(parts[0]), float(parts[1]), int(parts[2])
+    except (ValueError, IndexError):
+        raise _checks.fail(f"grid {key}", text, allowed) from None
+    if len(parts) != 3 or count < 1 or not (math.isfinite(start) and math.isfinite(stop)):
+        raise _checks.fail(f"grid {key}", text, allowed)
+    return np.linspace(start, stop, count).tolist()
+
+
+def _scalar(text: str) -> Any:
+    for kind in (int, float):
+        try:
+            return kind(text)
+        except ValueError:
+            pass
+    return {"true": True, "false": False}.get(text, text)
+
+
+def grid_from_table(table: Mapping, prefix: str = "") -> dict[str, list]:
+    """A file's ``[sweep.grid]`` as dotted path → values (nested tables are dotted keys).
+
+    A value is a list, or text in :func:`parse_values`'s grammar.
+
+    Examples
+    --------
+    >>> grid_from_table({"omega0": {"1": "0:0.1:3"}, "method": ["rkmk4"]})
+    {'omega0.1': [0.0, 0.05, 0.1], 'method': ['rkmk4']}
+    """
+    grid: dict[str, list] = {}
+    for key, value in table.items():
+        path = f"{prefix}.{key}" if prefix else str(key)
+        if isinstance(value, Mapping):
+            grid.update(grid_from_table(value, path))
+        elif isinstance(value, str):
+            grid[path] = parse_values(path, value)
+        else:
+            grid[path] = value
+    return grid
+
+
+# ---------------------------------------------------------------------------------------
 # Reading the scenario.
 
 
-def load_scenario(scenario: Any) -> tuple[dict, str, str]:
-    """``(options, source, sha256)`` of a scenario file, a ``rigid-body`` model or mapping."""
+def load_scenario(scenario: Any) -> tuple[dict, str, str, Any]:
+    """``(options, source, sha256, sweep)`` of a scenario file, a model or a mapping.
+
+    ``sweep`` is the file's ``[sweep]`` section (:class:`tumble.scenarios.files.Sweep`), or
+    None.
+    """
     if isinstance(scenario, rigid_body.Options):
         options = scenario.model_dump(mode="json", exclude_unset=True)
-        return options, "<options>", _hash(json.dumps(options, sort_keys=True).encode())
+        return options, "<options>", _hash(json.dumps(options, sort_keys=True).encode()), None
     if isinstance(scenario, Mapping):
         options = dict(validate(rigid_body.OPTIONS, dict(scenario), prefix="options")
                        .model_dump(mode="json", exclude_unset=True))  # fmt: skip
-        return options, "<options>", _hash(json.dumps(options, sort_keys=True).encode())
+        return options, "<options>", _hash(json.dumps(options, sort_keys=True).encode()), None
     if isinstance(scenario, str | Path) and str(scenario).endswith(".toml"):
         path = Path(scenario)
         found = read(path)
@@ -187,7 +256,7 @@ def load_scenario(scenario: Any) -> tuple[dict, str, str]:
                 f"{', '.join(SCENARIOS)} (write the body as a rigid-body file: "
                 "examples/t-handle-parts.toml)"
             )
-        return found.options, str(found.source), _hash(path.read_bytes())
+        return found.options, str(found.source), _hash(path.read_bytes()), found.sweep
     raise _checks.fail(
         "scenario", scenario,
         "a scenario file (.toml) of scenario 'rigid-body', its options as a mapping, or a "
@@ -312,7 +381,7 @@ def make_plan(
     scenario : str, Path, mapping or tumble.scenarios.rigid_body.Options
         A ``rigid-body`` scenario file, or its options.
     grid : mapping of str to sequence, optional
-        Option path → values; the values multiply.
+        Option path → values; the values multiply. Default: the file's ``[sweep.grid]``.
     samples : mapping of str to sequence, sequence of mappings, or DataFrame, optional
         One member per row, instead of ``grid``.
     chunk : int, optional
@@ -330,7 +399,10 @@ def make_plan(
         ``grid`` and ``samples``, or columns of different lengths: naming the key, the value
         and what is allowed.
     """
-    options, source, digest = load_scenario(scenario)
+    options, source, digest, section = load_scenario(scenario)
+    if grid is None and samples is None and section is not None and section.grid:
+        grid = grid_from_table(section.grid)
+        chunk = section.chunk if chunk is None else chunk
     if grid is not None and samples is not None:
         raise ValueError("give grid or samples, not both (a grid's values multiply; samples "
                          "are rows)")  # fmt: skip
