@@ -46,18 +46,19 @@ def draw_map(dataset, variable: str, path: str | Path, *, title: str = "") -> Pa
         )  # fmt: skip
     y, x = dims
     values = dataset[variable].squeeze(drop=True).transpose(y, x).values.astype(float)
-    _, units, text = SUMMARY[variable]
-    log = variable == "energy_error"
+    _, units, _ = SUMMARY[variable]
+    label = f"{variable} ({units})"
     heat_maps(
-        [(text, values)], dataset[x].values, dataset[y].values, path,
-        xlabel=_label(dataset, x), ylabel=_label(dataset, y), label=f"{variable} ({units})",
+        [(variable.replace("_", " "), values, label)], dataset[x].values, dataset[y].values,
+        path, xlabel=axis_label(dataset, x), ylabel=axis_label(dataset, y),
         title=title or f"{variable} — {Path(dataset.attrs.get('scenario_source', '')).name}",
-        log=log,
+        log={label} if variable == "energy_error" else (),
     )  # fmt: skip
     return Path(path)
 
 
-def _label(dataset, dim: str) -> str:
+def axis_label(dataset, dim: str) -> str:
+    """A swept dimension's axis label: its option path and unit."""
     path = dataset[dim].attrs.get("option_path", dim)
     units = {"omega0": "rad/s", "h": "s", "t_end": "s", "L0": "kg m²/s", "x0": "m", "v0": "m/s"}
     unit = next((u for key, u in units.items() if key in path.split(".")), "")

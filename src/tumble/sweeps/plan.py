@@ -74,6 +74,9 @@ class Plan:
         The scenario file, or ``"<options>"`` when given as a model or a mapping.
     source_hash : str
         SHA-256 of the file's bytes (or of the options' JSON).
+    names : tuple of str
+        The swept paths as the user wrote them (the grid's dimensions, the samples'
+        coordinates).
     time : ndarray or None
         The sample times every member shares (s), or None when they differ (a swept
         ``h``, ``t_end`` or ``record_every``, an adaptive method): then only the summary
@@ -89,6 +92,7 @@ class Plan:
     source: str
     source_hash: str
     time: np.ndarray | None
+    names: tuple[str, ...] = ()
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -124,7 +128,9 @@ class Plan:
     def grid_attr(self) -> str:
         """The sweep as JSON (the store's ``grid`` attribute): each dimension's path and values."""
         if self.samples:
-            columns = {dim_path(p): {"path": dim_path(p)} for p in self.paths}
+            columns = {
+                name: {"path": dim_path(p)} for name, p in zip(self.names, self.paths, strict=True)
+            }
             return json.dumps({"samples": columns, "members": self.size})
         return json.dumps(
             {dim: {"path": dim_path(p), "values": v}
@@ -432,7 +438,7 @@ def make_plan(
     per_member = SUMMARY_BYTES + (0 if time is None else len(time) * SERIES_BYTES)
     chunks = _chunks(shape, _chunk(chunk, per_member))
     return Plan(options, dims, tuple(paths), tuple(values), samples is not None, chunks,
-                source, digest, time)  # fmt: skip
+                source, digest, time, tuple(columns))  # fmt: skip
 
 
 def _columns(samples: Any) -> dict:

@@ -149,7 +149,9 @@ def _client(client: Any, timeout: float):
     if client is None:
         workers = os.cpu_count() or 1
         with (
-            LocalCluster(n_workers=workers, threads_per_worker=1, processes=True) as cluster,
+            LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
+            ) as cluster,
             Client(cluster) as local,
         ):
             yield local

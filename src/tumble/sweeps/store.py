@@ -41,8 +41,8 @@ def _coords(plan: Plan) -> dict:
     coords: dict = {}
     if plan.samples:
         coords["member"] = ("member", np.arange(plan.size))
-        for path, column in zip(plan.paths, plan.values, strict=True):
-            coords[dim_path(path)] = ("member", _array(column), {"option_path": dim_path(path)})
+        for name, path, column in zip(plan.names, plan.paths, plan.values, strict=True):
+            coords[name] = ("member", _array(column), {"option_path": dim_path(path)})
     else:
         for dim, path, values in zip(plan.dims, plan.paths, plan.values, strict=True):
             coords[dim] = (dim, _array(values), {"option_path": dim_path(path)})

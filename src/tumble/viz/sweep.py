@@ -1,8 +1,8 @@
-"""A sweep's map: a summary variable over two swept dimensions, as heat maps side by side."""
+"""A sweep's map: values over two swept dimensions, as heat maps side by side."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -31,54 +31,63 @@ def _axis(labels: Sequence) -> tuple[np.ndarray, list[str] | None]:
     return np.arange(len(array), dtype=float), [str(label) for label in array]
 
 
+def _limits(panels, log: Collection[str]) -> dict[str, tuple[float, float]]:
+    """The colour range of each colour label, over every panel that has it."""
+    limits = {}
+    for label in {label for _, _, label in panels}:
+        values = np.concatenate(
+            [v[np.isfinite(v)].ravel() for _, v, lab in panels if lab == label]
+        )
+        if label in log:
+            values = values[values > 0]
+        limits[label] = (values.min(), values.max()) if values.size else (LOG_FLOOR, 1.0)
+    return limits
+
+
 def heat_maps(
-    panels: Sequence[tuple[str, np.ndarray]],
+    panels: Sequence[tuple[str, np.ndarray, str]],
     x: Sequence,
     y: Sequence,
     path: str | Path,
     *,
     xlabel: str,
     ylabel: str,
-    label: str,
     title: str,
-    shared: bool = True,
-    log: bool = False,
+    log: Collection[str] = (),
 ) -> None:
     """Heat maps of values over ``(y, x)``, one panel each, side by side.
 
     Parameters
     ----------
-    panels : sequence of (str, ndarray (len(y), len(x)))
-        Each panel's title and values; NaN cells (no value: a run that failed, a period not
-        seen) are left white.
+    panels : sequence of (str, ndarray (len(y), len(x)), str)
+        Each panel's title, values and colour-bar label (with units). Panels with the same
+        label share one colour scale, so they can be compared cell by cell. NaN cells (a
+        run that failed, a period not seen) are left white.
     x, y : sequence
         The coordinates of the two swept dimensions (numbers, or names for a method).
     path : str or Path
         Output PNG.
     xlabel, ylabel : str
         The axes' names with units.
-    label : str
-        The colour bar's name with units.
     title : str
         Figure title.
-    shared : bool
-        One colour scale for every panel (to compare them); else each its own.
-    log : bool
-        A logarithmic colour scale (errors spanning decades); zeros are drawn at
-        :data:`LOG_FLOOR`.
+    log : collection of str
+        Colour labels drawn on a logarithmic scale (errors spanning decades); zeros are
+        drawn at :data:`LOG_FLOOR`.
     """
     from matplotlib.colors import LogNorm
 
     xs, xnames = _axis(x)
     ys, ynames = _axis(y)
-    if log:
-        panels = [(name, np.where(values > 0, values, LOG_FLOOR)) for name, values in panels]
-    finite = [values[np.isfinite(values)] for _, values in panels]
-    every = np.concatenate(finite) if finite else np.zeros(0)
-    limits = (every.min(), every.max()) if every.size and shared else (None, None)
+    panels = [
+        (name, np.where(values > 0, values, LOG_FLOOR) if label in log else values, label)
+        for name, values, label in panels
+    ]
+    limits = _limits(panels, log)
     fig, axes = new_figure(1, len(panels), figsize=(4.6 * len(panels) + 0.8, 4.2), squeeze=False)
-    for ax, (name, values) in zip(axes[0], panels, strict=True):
-        scale = {"norm": LogNorm(*limits)} if log else {"vmin": limits[0], "vmax": limits[1]}
+    for ax, (name, values, label) in zip(axes[0], panels, strict=True):
+        low, high = limits[label]
+        scale = {"norm": LogNorm(low, high)} if label in log else {"vmin": low, "vmax": high}
         mesh = ax.pcolormesh(_edges(xs), _edges(ys), np.ma.masked_invalid(values),
                              cmap="viridis", **scale)  # fmt: skip
         ax.set_title(name, fontsize=10)
