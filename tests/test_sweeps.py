@@ -246,3 +246,34 @@ def test_flip_map_example_agrees_with_the_exact_period(client, tmp_path):
     assert numbers["largest_relative_difference"] < 1e-6
     assert np.isfinite(numbers["measured"]).all()
     assert (tmp_path / "map.png").stat().st_size > 20_000
+
+
+def test_swept_attitude_under_gravity_equals_single_runs(client, tmp_path):
+    """Each member's attitude from its own table; gravity is constant, so one batch."""
+    gravity = [{"type": "gravity", "g": [0.0, 0.0, -9.81]}]
+    start = {"euler_zyx": [0.0, 0.0, 0.0], "omega0": [1.0, 5.0, 0.1], "v0": [0.0, 0.0, 1.0]}
+    base = tiny(loads=gravity, initial=start)
+    grid = {"euler_zyx.2": [0.0, 0.3, 1.2], "v0.1": [0.0, 2.0]}
+    ds = tumble.sweep(base, grid, client=client, store=tmp_path / "s.zarr")
+    for angle in grid["euler_zyx.2"]:
+        for speed in grid["v0.1"]:
+            initial = {**base["initial"], "euler_zyx": [0.0, 0.0, angle], "v0": [0.0, speed, 1.0]}
+            where = {"euler_zyx.2": angle, "v0.1": speed}
+            assert_member_equals(ds, where, {**base, "initial": initial})
+
+
+def test_batched_periods_equal_the_scenario_measure():
+    """members.periods (telescoped, vectorised) is t_handle.measured_period to round-off."""
+    from tumble import RigidBody, mass, simulate_batch
+    from tumble.scenarios.t_handle import measured_period
+    from tumble.sweeps.members import periods
+
+    body = RigidBody.from_mass_properties(mass.t_handle())
+    spins = [[1.0, 0.05, 0.0], [1.0, 0.01, 0.08], [0.05, 0.0, 1.0], [0.0, 1.0, 0.05]]
+    batch = simulate_batch(body, 100.0, h=0.05, omega0=spins)
+    found = periods(batch.t, batch.omega_body)
+    for k in range(len(spins)):
+        expected, _, _ = measured_period(batch.t, batch.omega_body[k])
+        assert found[k] == pytest.approx(expected, rel=1e-12)
+    short = simulate_batch(body, 10.0, h=0.05, omega0=spins[:1])  # under one crossing pair
+    assert np.isnan(periods(short.t, short.omega_body)).all()

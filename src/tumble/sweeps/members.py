@@ -7,15 +7,16 @@ fixed-step method under constant loads form one *group* and run in one
 the numbers of a single ``simulate`` run (``simulate_batch``'s contract), so a sweep's member
 equals the scenario run alone, bit for bit.
 
-Per member the task returns the state series on the plan's shared times (NaN after a run
-that stopped) and the summary variables of :data:`SUMMARY`.
+The options are checked once per group (every swept value was checked by the plan); the
+members' initial states are laid out as arrays without building each member's options, so
+a task of thousands of members spends its time in the compiled loop.
 """
 
 from __future__ import annotations
 
+import copy
 import json
 import time as clock
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,7 +26,7 @@ from tumble.rigid.methods import get_method
 from tumble.scenarios import rigid_body
 from tumble.scenarios.schema import validate
 from tumble.scenarios.t_handle import measured_period
-from tumble.sweeps.plan import Plan
+from tumble.sweeps.plan import Plan, set_path
 
 SERIES = {
     "x": (("axis",), "m", "centre of mass, world frame"),
@@ -48,16 +49,10 @@ SUMMARY = {
     "wall_time": ("float64", "s", "wall-clock time of the member (its share of its batch)"),
 }  # fmt: skip
 """The summary variables per member: dtype, units, long name."""
-
-
-@dataclass
-class _Member:
-    """One member's run, read into arrays."""
-
-    t: np.ndarray
-    series: dict[str, np.ndarray]
-    status: int
-    n_steps: int
+VECTORS = ("x0", "v0", "omega0", "L0")
+"""Initial vectors a task lays out as arrays (one row per member)."""
+ATTITUDES = ("R0", "q0", "euler_zyx")
+"""Initial attitudes: swept, each member's is built from its own table."""
 
 
 def run_members(plan: Plan, indices: list[tuple[int, ...]]) -> dict[str, np.ndarray]:
@@ -66,112 +61,168 @@ def run_members(plan: Plan, indices: list[tuple[int, ...]]) -> dict[str, np.ndar
     Returns
     -------
     dict
-        ``SERIES`` names (shape (m, n_time, …), only when ``plan.time`` is set) and
-        ``SUMMARY`` names (shape (m,)), in the order of ``indices``.
+        ``SERIES`` names (shape (m, n_time, …), only when ``plan.time`` is set; NaN after a
+        run that stopped) and ``SUMMARY`` names (shape (m,)), in the order of ``indices``.
     """
+    columns = [
+        [values[index[0] if plan.samples else index[k]] for index in indices]
+        for k, values in enumerate(plan.values)
+    ]
+    shared = [k for k, path in enumerate(plan.paths) if path[0] != "initial"]
     groups: dict[str, list[int]] = {}
-    options = [plan.member_options(index) for index in indices]
-    for k, member in enumerate(options):
-        shared = {key: value for key, value in member.items() if key != "initial"}
-        groups.setdefault(json.dumps(shared, sort_keys=True), []).append(k)
-    results: list[_Member | None] = [None] * len(indices)
-    walls = np.zeros(len(indices))
+    for m in range(len(indices)):
+        key = json.dumps([columns[k][m] for k in shared])
+        groups.setdefault(key, []).append(m)
+    out = _allocate(plan, len(indices))
     for members in groups.values():
         start = clock.perf_counter()
-        for k, result in zip(members, _run_group([options[k] for k in members]), strict=True):
-            results[k] = result
-        walls[members] = (clock.perf_counter() - start) / len(members)
-    return _stack(plan, [r for r in results if r is not None], walls)
+        options = copy.deepcopy(plan.options)
+        for k in shared:
+            set_path(options, plan.paths[k], columns[k][members[0]])
+        initial = {
+            path: np.asarray([columns[k][m] for m in members], dtype=float)
+            for k, path in enumerate(plan.paths)
+            if path[0] == "initial"
+        }
+        _run_group(plan, validate(rigid_body.OPTIONS, options), initial, members, out)
+        out["wall_time"][members] = (clock.perf_counter() - start) / len(members)
+    return out
 
 
-def _run_group(members: list[dict]) -> list[_Member]:
-    """Members sharing everything but the initial state: one batch when they can be."""
-    checked = validate(rigid_body.OPTIONS, members[0], prefix="options")
+def _allocate(plan: Plan, m: int) -> dict[str, np.ndarray]:
+    out: dict[str, np.ndarray] = {}
+    if plan.time is not None:
+        for name, (extra, _, _) in SERIES.items():
+            out[name] = np.full((m, len(plan.time), *(3 for _ in extra)), np.nan)
+    for name, (dtype, _, _) in SUMMARY.items():
+        out[name] = np.full(m, np.nan) if dtype == "float64" else np.zeros(m, dtype=dtype)
+    return out
+
+
+def _run_group(plan: Plan, checked, initial: dict, members: list[int], out: dict) -> None:
+    """Run members that share every option but the initial state; fill their rows of ``out``."""
     description: Any = checked.body  # a union of pydantic models, each with mass_properties
     properties = description.mass_properties()
     body = RigidBody.from_mass_properties(properties)
     com = np.asarray(properties.com)
     forces = [load.build(com) for load in checked.loads]
-    starts = [validate(rigid_body.Initial, m.get("initial", {})) for m in members]
-    compiled = all(getattr(load, "compiled", False) for load in forces)
-    batchable = (
-        not get_method(checked.method).adaptive
-        and compiled
-        and not any(isinstance(load, Impulse) for load in forces)
-    )
-    if batchable:
-        return _batch(checked, body, com, forces, starts)
-    return [_single(checked, body, com, forces, start) for start in starts]
+    starts = _initial_arrays(checked.initial, initial, len(members), com)
+    constant = all(getattr(load, "compiled", False) for load in forces)
+    impulses = any(isinstance(load, Impulse) for load in forces)
+    if not get_method(checked.method).adaptive and constant and not impulses:
+        batch = simulate_batch(
+            body, checked.t_end, method=checked.method, h=checked.h, forces=forces,
+            record_every=checked.record_every, **starts,
+        )  # fmt: skip
+        if plan.time is not None:
+            for name in SERIES:
+                out[name][members] = getattr(batch, name)
+        out["status"][members] = batch.status
+        out["n_steps"][members] = batch.n_steps
+        energy = batch.energy
+        last = np.take_along_axis(energy, batch.n_recorded[:, None] - 1, axis=1)[:, 0]
+        out["energy_error"][members] = _energy_error(energy[:, 0], last)
+        out["flip_period"][members] = np.where(
+            batch.status >= 0, periods(batch.t, batch.omega_body), np.nan
+        )
+        return
+    for row, m in enumerate(members):
+        given = {name: value[row] for name, value in starts.items()}
+        trajectory = simulate(
+            body, checked.t_end, method=checked.method, h=checked.h, rtol=checked.rtol,
+            atol=checked.atol, forces=forces, record_every=checked.record_every, **given,
+        )  # fmt: skip
+        if plan.time is not None:
+            for name in SERIES:
+                values = getattr(trajectory, name)
+                out[name][m, : len(values)] = values
+        out["status"][m] = trajectory.status
+        out["n_steps"][m] = trajectory.n_steps
+        energy = trajectory.energy
+        out["energy_error"][m] = _energy_error(energy[:1], energy[-1:])[0]
+        period, _, _ = measured_period(trajectory.t, trajectory.omega_body)
+        out["flip_period"][m] = np.nan if period is None or trajectory.status < 0 else period
 
 
-def _initial_arrays(com: np.ndarray, starts: list) -> dict:
-    """``simulate_batch``'s per-body arrays: each given by every member, or by none."""
-    arrays: dict = {"x0": np.array([com if s.x0 is None else s.x0 for s in starts])}
-    arrays["R0"] = np.array([s.attitude() for s in starts])
-    for name in ("v0", "omega0", "L0"):
-        given = [getattr(s, name) for s in starts]
-        if any(value is not None for value in given):
-            arrays[name] = np.array([np.zeros(3) if v is None else v for v in given])
+def _initial_arrays(start, swept: dict, m: int, com: np.ndarray) -> dict[str, np.ndarray]:
+    """``simulate``'s initial arguments, one row per member.
+
+    ``start`` is the group's checked ``[options.initial]``; ``swept`` maps each swept
+    ``initial`` path to its members' values. ``x0`` defaults to the centre of mass, as
+    :func:`tumble.scenarios.rigid_body.run` does.
+    """
+    arrays: dict[str, np.ndarray] = {}
+    for name in VECTORS:
+        base = getattr(start, name)
+        paths = [path for path in swept if path[1] == name]
+        if base is None and not paths and name != "x0":
+            continue
+        row = com if base is None and name == "x0" else base
+        array = np.tile(np.asarray(row if row is not None else np.zeros(3), dtype=float), (m, 1))
+        for path in paths:
+            if len(path) == 3:
+                array[:, path[2]] = swept[path]
+            else:
+                array[:] = swept[path]
+        arrays[name] = array
+    if any(path[1] in ATTITUDES for path in swept):
+        base = start.model_dump(exclude_none=True)
+        tables = [copy.deepcopy(base) for _ in range(m)]
+        for path, values in swept.items():
+            for table, value in zip(tables, values.tolist(), strict=True):
+                set_path(table, path[1:], value)
+        attitudes = [validate(rigid_body.Initial, table).attitude() for table in tables]
+        arrays["R0"] = np.array(attitudes)
+    else:
+        arrays["R0"] = np.tile(start.attitude(), (m, 1, 1))
     return arrays
 
 
-def _batch(checked, body, com, forces, starts) -> list[_Member]:
-    batch = simulate_batch(
-        body, checked.t_end, method=checked.method, h=checked.h, forces=forces,
-        record_every=checked.record_every, **_initial_arrays(com, starts),
-    )  # fmt: skip
-    series = {name: getattr(batch, name) for name in SERIES}
-    return [
-        _Member(
-            t=batch.t[: batch.n_recorded[k]],
-            series={name: values[k, : batch.n_recorded[k]] for name, values in series.items()},
-            status=int(batch.status[k]),
-            n_steps=int(batch.n_steps[k]),
-        )
-        for k in range(len(batch))
-    ]
+def _energy_error(first: np.ndarray, last: np.ndarray) -> np.ndarray:
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return np.where(first != 0, np.abs(last / first - 1), np.nan)
 
 
-def _single(checked, body, com, forces, start) -> _Member:
-    trajectory = simulate(
-        body, checked.t_end, method=checked.method, h=checked.h, rtol=checked.rtol,
-        atol=checked.atol, x0=com if start.x0 is None else start.x0, v0=start.v0,
-        R0=start.attitude(), omega0=start.omega0, L0=start.L0, forces=forces,
-        record_every=checked.record_every,
-    )  # fmt: skip
-    return _Member(
-        t=trajectory.t,
-        series={name: getattr(trajectory, name) for name in SERIES},
-        status=int(trajectory.status),
-        n_steps=int(trajectory.n_steps),
-    )
+def periods(t: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """:func:`~tumble.scenarios.t_handle.measured_period` of many runs on one time grid.
+
+    The mean of ``c[k + 2] − c[k]`` over the crossings ``c`` of the most-crossing component
+    telescopes to ``(c[-1] + c[-2] − c[0] − c[1]) / (len(c) − 2)``, so only the first two and
+    last two crossings of each run are located.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Times (s).
+    omega : ndarray, shape (m, n, 3)
+        Body angular velocities (rad/s); NaN after a run that stopped.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The periods (s); NaN where fewer than three crossings were seen.
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        positive = omega >= 0
+        changes = positive[:, :-1] != positive[:, 1:]  # (m, n - 1, 3)
+        component = np.argmax(changes.sum(axis=1), axis=1)
+        rows = np.arange(len(omega))
+        values = omega[rows, :, component]  # (m, n)
+        crossing = changes[rows, :, component]
+        count = crossing.sum(axis=1)
+        dt = t[1:] - t[:-1]
+        times = t[:-1] - values[:, :-1] * dt / (values[:, 1:] - values[:, :-1])
+        order = np.cumsum(crossing, axis=1)
+        first = _at(times, order, crossing, 1)
+        second = _at(times, order, crossing, 2)
+        last = _at(times, order, crossing, count)
+        before_last = _at(times, order, crossing, count - 1)
+        period = (last + before_last - first - second) / (count - 2)
+    return np.where(count >= 3, period, np.nan)
 
 
-def _stack(plan: Plan, results: list[_Member], walls: np.ndarray) -> dict[str, np.ndarray]:
-    out: dict[str, np.ndarray] = {}
-    if plan.time is not None:
-        n = len(plan.time)
-        for name, (extra, _, _) in SERIES.items():
-            shape = (len(results), n, *(3 for _ in extra))
-            stacked = np.full(shape, np.nan)
-            for k, result in enumerate(results):
-                values = result.series[name]
-                stacked[k, : len(values)] = values
-            out[name] = stacked
-    out["status"] = np.array([r.status for r in results], dtype=np.int8)
-    out["n_steps"] = np.array([r.n_steps for r in results], dtype=np.int64)
-    out["energy_error"] = np.array([_energy_error(r.series["energy"]) for r in results])
-    out["flip_period"] = np.array([_period(r) for r in results])
-    out["wall_time"] = walls
-    return out
-
-
-def _energy_error(energy: np.ndarray) -> float:
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return float(abs(energy[-1] / energy[0] - 1)) if energy[0] != 0 else np.nan
-
-
-def _period(result: _Member) -> float:
-    with np.errstate(all="ignore"):
-        period, _, _ = measured_period(result.t, result.series["omega_body"])
-    return np.nan if period is None else period
+def _at(times: np.ndarray, order: np.ndarray, crossing: np.ndarray, k) -> np.ndarray:
+    """The time of each run's ``k``-th crossing (1-based; NaN where there is none)."""
+    hit = crossing & (order == np.reshape(k, (-1, 1)))
+    index = np.argmax(hit, axis=1)
+    return np.where(hit.any(axis=1), times[np.arange(len(times)), index], np.nan)

@@ -122,7 +122,7 @@ class Plan:
         """The options of the member at ``index`` (its position along ``dims``)."""
         options = copy.deepcopy(self.options)
         for k, (path, values) in enumerate(zip(self.paths, self.values, strict=True)):
-            _set(options, path, values[index[0] if self.samples else index[k]])
+            set_path(options, path, values[index[0] if self.samples else index[k]])
         return options
 
     def grid_attr(self) -> str:
@@ -304,7 +304,8 @@ def resolve(key: Any, options: dict) -> tuple:
     )
 
 
-def _set(options: dict, path: tuple, value: Any) -> None:
+def set_path(options: dict, path: tuple, value: Any) -> None:
+    """Set ``options[path[0]][path[1]]… = value``, making missing tables (or lists) on the way."""
     node: Any = options
     for position, part in enumerate(path[:-1]):
         following = path[position + 1]
@@ -343,7 +344,7 @@ def _check_path(key: str, path: tuple, options: dict) -> None:
 def _check_value(key: str, path: tuple, value: Any, options: dict) -> None:
     trial = copy.deepcopy(options)
     try:
-        _set(trial, path, value)
+        set_path(trial, path, value)
         validate(rigid_body.OPTIONS, trial, prefix="options")
     except (ValueError, TypeError, IndexError) as error:
         raise ValueError(f"grid key {key!r}, value {short_repr(value)}: {error}") from None
