@@ -144,14 +144,14 @@ def _run_group(plan: Plan, checked, initial: dict, members: list[int], out: dict
         out["flip_period"][m] = np.nan if period is None or trajectory.status < 0 else period
 
 
-def _initial_arrays(start, swept: dict, m: int, com: np.ndarray) -> dict[str, np.ndarray]:
+def _initial_arrays(start, swept: dict, m: int, com: np.ndarray) -> dict[str, Any]:
     """``simulate``'s initial arguments, one row per member.
 
     ``start`` is the group's checked ``[options.initial]``; ``swept`` maps each swept
     ``initial`` path to its members' values. ``x0`` defaults to the centre of mass, as
     :func:`tumble.scenarios.rigid_body.run` does.
     """
-    arrays: dict[str, np.ndarray] = {}
+    arrays: dict[str, Any] = {}
     for name in VECTORS:
         base = getattr(start, name)
         paths = [path for path in swept if path[1] == name]
