@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import logging
 import os
 from collections.abc import Callable, Mapping, Sequence
@@ -27,12 +28,30 @@ def run_task(plan: Plan, store: str, task: tuple[int, ...]) -> int:
     numbers (a task is rerun when its worker dies), so a retried task is harmless.
     """
     region = plan.region(task)
-    ranges = [range(s.start, s.stop) for s in region.values()]
-    import itertools
-
-    indices = list(itertools.product(*ranges))
-    write_region(plan, store, task, run_members(plan, indices))
+    indices = list(itertools.product(*(range(s.start, s.stop) for s in region.values())))
+    with _threads():
+        values = run_members(plan, indices)
+    write_region(plan, store, task, values)
     return len(indices)
+
+
+@contextmanager
+def _threads():
+    """Numba's threads on a Dask worker: the worker's own (one worker a core), not every core."""
+    import numba
+    from distributed import get_worker
+
+    try:
+        wanted = get_worker().state.nthreads
+    except ValueError:  # not on a worker (called directly): leave numba's default
+        yield
+        return
+    before = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(wanted, numba.config.NUMBA_NUM_THREADS)))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
 
 
 def sweep(

@@ -110,6 +110,7 @@ def write_template(plan: Plan, store: str | Path) -> None:
 def write_region(plan: Plan, store: str | Path, task: tuple[int, ...], values: dict) -> None:
     """Write one task's members, then their ``done`` flags (a second, later write)."""
     import xarray as xr
+    import zarr
 
     region = plan.region(task)
     block = tuple(s.stop - s.start for s in region.values())
@@ -119,8 +120,9 @@ def write_region(plan: Plan, store: str | Path, task: tuple[int, ...], values: d
         dims = plan.dims if extra is None else (*plan.dims, "time", *extra)
         data[name] = (dims, array.reshape(*block, *array.shape[1:]))
     xr.Dataset(data).to_zarr(store, region=region, mode="r+", consolidated=False)
-    done = xr.Dataset({"done": (plan.dims, np.ones(block, dtype="uint8"))})
-    done.to_zarr(store, region=region, mode="r+", consolidated=False)
+    # the flags after the data, straight into their array (the metadata is the template's)
+    flags = zarr.open_array(Path(store) / "done", mode="r+", zarr_format=FORMAT)
+    flags[tuple(region.values())] = 1
 
 
 def check_existing(plan: Plan, store: str | Path) -> None:
