@@ -5,6 +5,7 @@ from __future__ import annotations
 import itertools
 import logging
 import os
+import uuid
 from collections.abc import Callable, Mapping, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -134,8 +135,9 @@ def sweep(
         if progress is not None:
             progress(done, plan.size)
         shared = dask_client.scatter(plan, broadcast=True)
+        token = uuid.uuid4().hex[:8]  # a new key each run: a resumed sweep never gets old results
         futures = [
-            dask_client.submit(run_task, shared, store, task, pure=False, key=_key(store, task))
+            dask_client.submit(run_task, shared, store, task, key=_key(token, task))
             for task in tasks
         ]
         for future in as_completed(futures):
@@ -146,8 +148,9 @@ def sweep(
     return xr.open_zarr(store)
 
 
-def _key(store: str, task: tuple[int, ...]) -> str:
-    return f"tumble-sweep-{abs(hash(store))}-" + "-".join(map(str, task))
+def _key(token: str, task: tuple[int, ...]) -> str:
+    """The task's name on the dashboard: ``tumble-sweep-<run>-<block index>``."""
+    return f"tumble-sweep-{token}-" + "-".join(map(str, task))
 
 
 def _members(plan: Plan, task: tuple[int, ...]) -> int:
