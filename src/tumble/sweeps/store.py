@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 
@@ -32,7 +33,7 @@ from tumble._version import __version__
 from tumble.sweeps.members import SERIES, SUMMARY
 from tumble.sweeps.plan import Plan, dim_path
 
-FORMAT = 2
+FORMAT: Literal[2] = 2
 """Zarr format: version 2 has consolidated metadata and string arrays in its specification."""
 _EXTRA = {"axis": ["x", "y", "z"], "row": [0, 1, 2], "col": [0, 1, 2]}
 
