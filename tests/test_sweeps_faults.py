@@ -147,3 +147,28 @@ def test_killed_worker_leaves_the_sweep_to_the_other(cluster, tmp_path):
     with Client(address, timeout=10) as client:
         assert len(client.scheduler_info()["workers"]) == 1
     assert_every_member_is_its_serial_run(ds)
+
+
+def test_output_larger_than_the_worker_memory_limit_completes(tmp_path):
+    """One worker limited to 400 MB writes 450 MB of members: each task writes its region
+    and forgets it, so the worker is never restarted (same process before and after)."""
+    from distributed import Client, LocalCluster
+
+    limit = 400e6
+    members = 1280  # x 2001 samples x 176 bytes: 451 MB
+    options = {**OPTIONS, "h": 0.005, "t_end": 10.0, "record_every": 1}
+    with (
+        LocalCluster(n_workers=1, threads_per_worker=1, memory_limit=limit,
+                     dashboard_address=":0") as cluster,
+        Client(cluster) as client,
+    ):  # fmt: skip
+        before = client.run(os.getpid)
+        spins = np.linspace(0.0, 1.0, members)
+        ds = tumble.sweep(options, {"omega0.2": spins}, client=client, store=tmp_path / "s.zarr")
+        assert client.run(os.getpid) == before
+    assert ds.nbytes > limit
+    assert ds["done"].values.all()
+    trajectory = rigid_body.run(**{**options, "initial": {"omega0": [0.1, 20.0, 1.0]}}).data[
+        "trajectory"
+    ]
+    assert np.array_equal(ds["R"].isel({"omega0.2": -1}).values, trajectory.R)

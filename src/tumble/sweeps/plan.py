@@ -40,7 +40,7 @@ from tumble.scenarios.schema import short_repr, validate
 
 SCENARIOS = ("rigid-body",)
 """Scenarios a sweep runs: each member is one rigid body's :class:`~tumble.rigid.Trajectory`."""
-CHUNK_BYTES = 64 * 2**20
+CHUNK_BYTES = 16 * 2**20
 """Default size of one task's output (bytes): a worker holds about this much at a time."""
 MAX_CHUNK = 4096
 """Default largest number of members in one task."""
