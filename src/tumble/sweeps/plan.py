@@ -118,13 +118,6 @@ class Plan:
             for dim, k, c, n in zip(self.dims, task, self.chunks, self.shape, strict=True)
         }
 
-    def member_options(self, index: tuple[int, ...]) -> dict:
-        """The options of the member at ``index`` (its position along ``dims``)."""
-        options = copy.deepcopy(self.options)
-        for k, (path, values) in enumerate(zip(self.paths, self.values, strict=True)):
-            set_path(options, path, values[index[0] if self.samples else index[k]])
-        return options
-
     def grid_attr(self) -> str:
         """The sweep as JSON (the store's ``grid`` attribute): each dimension's path and values."""
         if self.samples:
@@ -418,7 +411,8 @@ def make_plan(
         raise _checks.fail(
             "samples" if samples is not None else "grid", columns,
             "a mapping of at least one option path to a non-empty list of values",
-            remedy="for example grid={'omega0.1': [0.01, 0.05], 'method': ['rkmk4']}",
+            remedy="for example grid={'omega0.1': [0.01, 0.05], 'method': ['rkmk4']}; on the "
+            "command line --grid PATH=VALUES, or a [sweep.grid] table in the file",
         )  # fmt: skip
     paths, values = [], []
     for key, given in columns.items():
