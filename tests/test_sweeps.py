@@ -156,6 +156,40 @@ def test_bad_grids_are_refused_before_any_work(tmp_path, grid, message):
     assert not store.exists()
 
 
+def test_samples_as_rows_columns_or_a_table_give_one_plan():
+    columns = {"omega0.1": [18.0, 19.0, 21.0], "method": ["rkmk4", "lie-euler", "rkmk4"]}
+    rows = [dict(zip(columns, row, strict=True)) for row in zip(*columns.values(), strict=True)]
+    by_columns, by_rows = make_plan(tiny(), samples=columns), make_plan(tiny(), samples=rows)
+    assert by_columns.values == by_rows.values == (columns["omega0.1"], columns["method"])
+    assert by_columns.dims == ("member",) and by_columns.shape == (3,)
+    assert by_columns.paths == (("initial", "omega0", 1), ("method",))
+
+
+@pytest.mark.parametrize(
+    ("samples", "message"),
+    [
+        ({"h": [0.01, 0.02], "omega0.1": [1.0]}, r"samples=\{'h': 2, 'omega0.1': 1\} is not "
+         r"allowed: must be columns of one length"),
+        ([{"h": 0.01}, {"t_end": 1.0}], r"samples\[1\]=\{'t_end': 1.0\} is not allowed: must "
+         r"be a row with keys \['h'\]"),
+        ({"h": [0.01, float("nan")]}, r"grid key 'h', value nan: options.h = nan: must be a "
+         r"finite number"),
+    ],
+)  # fmt: skip
+def test_bad_samples_are_refused(samples, message):
+    with pytest.raises(ValueError, match=message):
+        make_plan(tiny(), samples=samples)
+
+
+def test_tasks_are_blocks_of_the_grid_that_cover_every_member_once():
+    plan = make_plan(tiny(), {"omega0.1": [1.0, 2.0, 3.0], "method": FIXED_METHODS}, chunk=4)
+    covered = np.zeros(plan.shape, dtype=int)
+    for task in plan.tasks():
+        covered[tuple(plan.region(task).values())] += 1
+    assert (covered == 1).all()
+    assert plan.chunks == (1, 4)  # whole trailing rows first, then cut
+
+
 def test_an_existing_store_without_resume_is_refused(tmp_path):
     store = tmp_path / "s.zarr"
     store.mkdir()

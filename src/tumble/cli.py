@@ -357,7 +357,7 @@ def sweep(
     """Run a scenario over a grid of options on Dask, into one Zarr store."""
     from tumble.sweeps import sweep as run_sweep
     from tumble.sweeps.picture import draw_map, swept_dims
-    from tumble.sweeps.plan import parse_values
+    from tumble.sweeps.text import parse_values
 
     with _reported():
         values = {}
