@@ -190,6 +190,16 @@ def test_tasks_are_blocks_of_the_grid_that_cover_every_member_once():
     assert plan.chunks == (1, 4)  # whole trailing rows first, then cut
 
 
+def test_a_scenario_other_than_rigid_body_is_refused_by_name(tmp_path):
+    with pytest.raises(
+        ValueError,
+        match=r"t-handle.toml: scenario = 't-handle' cannot be "
+        r"swept; allowed: rigid-body \(write the body as a rigid-body file",
+    ):
+        tumble.sweep(EXAMPLES / "t-handle.toml", {"h": [0.01]}, store=tmp_path / "s")
+    assert not (tmp_path / "s").exists()
+
+
 def test_an_existing_store_without_resume_is_refused(tmp_path):
     store = tmp_path / "s.zarr"
     store.mkdir()

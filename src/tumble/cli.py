@@ -329,7 +329,7 @@ Grid = Annotated[
     typer.Option(
         "--grid",
         help="PATH=start:stop:count or PATH=a,b,c (repeat; the values multiply). "
-        "Default: the file's [sweep.grid].",
+        "Default: the file's sweep.grid table.",
     ),
 ]
 
@@ -351,7 +351,11 @@ def sweep(
     timeout: Annotated[float, typer.Option(help="Seconds to wait for --scheduler.")] = 10.0,
     draw: Annotated[
         str | None,
-        typer.Option("--map", help="Draw this summary variable over the two swept dimensions."),
+        typer.Option(
+            "--map",
+            help="Draw this summary variable over the two swept dimensions: flip_period "
+            "(default), energy_error, wall_time, status, n_steps.",
+        ),
     ] = None,
 ) -> None:
     """Run a scenario over a grid of options on Dask, into one Zarr store."""
