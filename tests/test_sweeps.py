@@ -190,13 +190,32 @@ def test_tasks_are_blocks_of_the_grid_that_cover_every_member_once():
     assert plan.chunks == (1, 4)  # whole trailing rows first, then cut
 
 
-def test_a_scenario_other_than_rigid_body_is_refused_by_name(tmp_path):
+def test_a_built_in_scenario_sweeps_its_summary_numbers(client, tmp_path):
+    """A built-in by name: each member is run(**options), its summary's numbers stored."""
+    from tumble.scenarios import t_handle
+
+    grid = {"spins.0.1": [0.05, 0.1], "method": ["rkmk4", "split-axes"]}
+    base = {"spins": [[1.0, 0.05, 0.0]], "t_end": 100.0, "h": 0.02}
+    ds = tumble.sweep("t-handle", {**grid, "t_end": [100.0], "h": [0.02]}, client=client,
+                      store=tmp_path / "s.zarr")  # fmt: skip
+    assert ds.attrs["scenario"] == "t-handle"
+    assert ds["spins.0.period_measured"].dims == ("spins.0.1", "method", "t_end", "h")
+    for spin in grid["spins.0.1"]:
+        for method in grid["method"]:
+            options = {**base, "method": method, "spins": [[1.0, spin, 0.0]]}
+            expected = t_handle.run(**options).summary["spins"][0]
+            member = ds.sel({"spins.0.1": spin, "method": method, "t_end": 100.0, "h": 0.02})
+            for name in ("period_measured", "energy_drift", "error_vs_exact"):
+                assert float(member[f"spins.0.{name}"]) == expected[name], (spin, method, name)
+
+
+def test_a_built_in_scenario_refuses_an_unknown_path(tmp_path):
     with pytest.raises(
         ValueError,
-        match=r"t-handle.toml: scenario = 't-handle' cannot be "
-        r"swept; allowed: rigid-body \(write the body as a rigid-body file",
+        match=r"grid key 'spinz.0' is not an option path of "
+        r"scenario 't-handle'; allowed: h, method, rtol, spins, t_end",
     ):
-        tumble.sweep(EXAMPLES / "t-handle.toml", {"h": [0.01]}, store=tmp_path / "s")
+        tumble.sweep("t-handle", {"spinz.0": [1.0]}, store=tmp_path / "s")
     assert not (tmp_path / "s").exists()
 
 

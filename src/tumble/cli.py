@@ -336,7 +336,7 @@ Grid = Annotated[
 
 @app.command()
 def sweep(
-    file: Annotated[Path, typer.Argument(help="A rigid-body scenario file (.toml).")],
+    file: Annotated[Path, typer.Argument(help="A scenario file (.toml).")],
     grid: Grid = None,
     out: Annotated[Path, typer.Option(help="The Zarr store to write (a folder).")] = Path(
         "runs/sweep.zarr"
@@ -380,14 +380,17 @@ def sweep(
                 resume=resume, timeout=timeout,
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
             )  # fmt: skip
-        status = dataset["status"].values
+        done = dataset["done"].values
         table = Table(title=f"sweep: {out}", box=None, show_header=False)
-        table.add_row("members", f"{status.size} ({' x '.join(map(str, status.shape))})")
-        table.add_row("reached t_end", str(int((status == 0).sum())))
-        table.add_row("stopped (failed)", str(int((status < 0).sum())))
+        table.add_row("members", f"{done.size} ({' x '.join(map(str, done.shape))})")
+        if "status" in dataset:
+            status = dataset["status"].values
+            table.add_row("reached t_end", str(int((status == 0).sum())))
+            table.add_row("stopped (failed)", str(int((status < 0).sum())))
         table.add_row("wall time of the members", f"{float(dataset['wall_time'].sum()):.3g} s")
         console.print(table)
-        name = draw or ("flip_period" if len(swept_dims(dataset)) == 2 else None)
+        two = len(swept_dims(dataset)) == 2 and "flip_period" in dataset
+        name = draw or ("flip_period" if two else None)
         if name is not None:
             picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
             console.print(f"map: {picture}", highlight=False)

@@ -26,7 +26,7 @@ from tumble.rigid.methods import get_method
 from tumble.scenarios import rigid_body
 from tumble.scenarios.schema import validate
 from tumble.scenarios.t_handle import measured_period
-from tumble.sweeps.plan import Plan, set_path
+from tumble.sweeps.plan import RIGID, Plan, set_path
 
 SERIES = {
     "x": (("axis",), "m", "centre of mass, world frame"),
@@ -55,6 +55,52 @@ ATTITUDES = ("R0", "q0", "euler_zyx")
 """Initial attitudes: swept, each member's is built from its own table."""
 
 
+def summary_numbers(summary: Any, key: str = "") -> dict[str, float]:
+    """The numbers of a scenario's summary, by dotted key: what a built-in's sweep stores.
+
+    Numbers, flags (0/1) and None (NaN) inside tables, and inside lists of tables (indexed
+    from 0, as option paths are: ``spins.0.period_measured``); lists of numbers and text
+    are left out.
+
+    Examples
+    --------
+    >>> summary_numbers({"h": 0.01, "spins": [{"period": 47.2, "ok": True}], "dt": [1, 2]})
+    {'h': 0.01, 'spins.0.period': 47.2, 'spins.0.ok': 1.0}
+    """
+    if isinstance(summary, dict):
+        found: dict[str, float] = {}
+        for name, value in summary.items():
+            found.update(summary_numbers(value, f"{key}.{name}" if key else str(name)))
+        return found
+    if isinstance(summary, list) and summary and all(isinstance(v, dict) for v in summary):
+        found = {}
+        for index, value in enumerate(summary):
+            found.update(summary_numbers(value, f"{key}.{index}"))
+        return found
+    if summary is None or isinstance(summary, bool | int | float):
+        return {key: np.nan if summary is None else float(summary)}
+    return {}
+
+
+def run_summaries(plan: Plan, indices: list[tuple[int, ...]]) -> dict[str, np.ndarray]:
+    """A built-in scenario's members, one ``run`` each: their summaries' numbers and times."""
+    from tumble.scenarios import registry
+    from tumble.scenarios.files import check_options
+
+    out = {name: np.full(len(indices), np.nan) for name in (*plan.outputs, "wall_time")}
+    for m, index in enumerate(indices):
+        start = clock.perf_counter()
+        options = copy.deepcopy(plan.options)
+        for k, (path, values) in enumerate(zip(plan.paths, plan.values, strict=True)):
+            set_path(options, path, values[index[0] if plan.samples else index[k]])
+        result = registry.get(plan.scenario).run(**check_options(plan.scenario, options))
+        for name, value in summary_numbers(result.summary).items():
+            if name in out:
+                out[name][m] = value
+        out["wall_time"][m] = clock.perf_counter() - start
+    return out
+
+
 def run_members(plan: Plan, indices: list[tuple[int, ...]]) -> dict[str, np.ndarray]:
     """Run the members at ``indices``; their variables stacked along a leading member axis.
 
@@ -62,8 +108,11 @@ def run_members(plan: Plan, indices: list[tuple[int, ...]]) -> dict[str, np.ndar
     -------
     dict
         ``SERIES`` names (shape (m, n_time, …), only when ``plan.time`` is set; NaN after a
-        run that stopped) and ``SUMMARY`` names (shape (m,)), in the order of ``indices``.
+        run that stopped) and ``SUMMARY`` names (shape (m,)), in the order of ``indices``;
+        for a built-in scenario, :func:`run_summaries`'.
     """
+    if plan.scenario != RIGID:
+        return run_summaries(plan, indices)
     columns = [
         [values[index[0] if plan.samples else index[k]] for index in indices]
         for k, values in enumerate(plan.values)

@@ -5,7 +5,6 @@ from __future__ import annotations
 from pathlib import Path
 
 from tumble import _checks
-from tumble.sweeps.members import SUMMARY
 
 
 def swept_dims(dataset) -> list[str]:
@@ -22,8 +21,9 @@ def draw_map(dataset, variable: str, path: str | Path, *, title: str = "") -> Pa
     dataset : xarray.Dataset
         A sweep's store (:func:`tumble.sweep`).
     variable : str
-        A summary variable (:data:`~tumble.sweeps.members.SUMMARY`): ``flip_period``,
-        ``energy_error``, ``wall_time``, ``status``, ``n_steps``.
+        A per-member variable: for a rigid-body sweep one of
+        :data:`~tumble.sweeps.members.SUMMARY` (``flip_period``, ``energy_error``,
+        ``wall_time``, ``status``, ``n_steps``); for a built-in, a number of its summary.
     path : str or Path
         Output PNG.
     title : str
@@ -32,12 +32,14 @@ def draw_map(dataset, variable: str, path: str | Path, *, title: str = "") -> Pa
     Raises
     ------
     ValueError
-        If ``variable`` is not a summary variable, or the sweep has not exactly two swept
+        If ``variable`` is not a per-member variable, or the sweep has not exactly two swept
         dimensions (other dimensions must have one value).
     """
     from tumble.viz.sweep import heat_maps
 
-    _checks.choice("map", variable, list(SUMMARY))
+    members = dataset["done"].dims
+    names = [name for name in dataset.data_vars if dataset[name].dims == members]
+    _checks.choice("map", variable, [name for name in names if name != "done"])
     dims = swept_dims(dataset)
     if len(dims) != 2:
         raise _checks.fail(
@@ -46,8 +48,8 @@ def draw_map(dataset, variable: str, path: str | Path, *, title: str = "") -> Pa
         )  # fmt: skip
     y, x = dims
     values = dataset[variable].squeeze(drop=True).transpose(y, x).values.astype(float)
-    _, units, _ = SUMMARY[variable]
-    label = f"{variable} ({units})"
+    units = dataset[variable].attrs.get("units", "")
+    label = f"{variable} ({units})" if units else variable
     heat_maps(
         [(variable.replace("_", " "), values, label)], dataset[x].values, dataset[y].values,
         path, xlabel=axis_label(dataset, x), ylabel=axis_label(dataset, y),
@@ -60,6 +62,14 @@ def draw_map(dataset, variable: str, path: str | Path, *, title: str = "") -> Pa
 def axis_label(dataset, dim: str) -> str:
     """A swept dimension's axis label: its option path and unit."""
     path = dataset[dim].attrs.get("option_path", dim)
-    units = {"omega0": "rad/s", "h": "s", "t_end": "s", "L0": "kg m²/s", "x0": "m", "v0": "m/s"}
+    units = {
+        "omega0": "rad/s",
+        "spins": "rad/s",
+        "h": "s",
+        "t_end": "s",
+        "L0": "kg m²/s",
+        "x0": "m",
+        "v0": "m/s",
+    }
     unit = next((u for key, u in units.items() if key in path.split(".")), "")
     return f"{path} ({unit})" if unit else path

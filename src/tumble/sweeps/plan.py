@@ -1,10 +1,11 @@
 """What a sweep runs: the scenario, the swept option paths, the members and their tasks.
 
-A sweep is one scenario file (or its options model) and a set of *option paths*, each with
-values. A path is dotted, relative to the file's ``[options]``: ``h``, ``method``,
-``initial.omega0.1`` (entry 1 of the list), ``loads.0.impulse.2``, ``body.density``. A path
-whose first key is not an option but a key of ``[options.initial]`` (``omega0.1``) or the type
-of the one load of that type (``impulse.point.0``) is short for the full path.
+A sweep is one scenario (a file, a built-in's name, or the ``rigid-body`` options) and a set
+of *option paths*, each with values. A path is dotted, relative to the file's ``[options]``:
+``h``, ``method``, ``initial.omega0.1`` (entry 1 of the list), ``loads.0.impulse.2``,
+``body.density``, ``spins.0.1``. For ``rigid-body``, a path whose first key is not an option
+but a key of ``[options.initial]`` (``omega0.1``) or the type of the one load of that type
+(``impulse.point.0``) is short for the full path.
 
 * ``grid``: the paths' values multiply, each path is a dimension of the output;
 * ``samples``: a table of rows (columns of equal length, one per path), one member per row,
@@ -23,6 +24,7 @@ from __future__ import annotations
 
 import copy
 import hashlib
+import inspect
 import itertools
 import json
 import math
@@ -34,13 +36,14 @@ from typing import Any
 import numpy as np
 
 from tumble import _checks
-from tumble.scenarios import rigid_body
-from tumble.scenarios.files import read
+from tumble.scenarios import registry, rigid_body
+from tumble.scenarios.files import check_options, read
+from tumble.scenarios.option_models import options_model
 from tumble.scenarios.schema import short_repr, validate
 from tumble.sweeps.text import grid_from_table
 
-SCENARIOS = ("rigid-body",)
-"""Scenarios a sweep runs: each member is one rigid body's :class:`~tumble.rigid.Trajectory`."""
+RIGID = "rigid-body"
+"""The scenario whose members are trajectories (batched); any other stores its summary."""
 CHUNK_BYTES = 16 * 2**20
 """Default size of one task's output (bytes): a worker holds about this much at a time."""
 MAX_CHUNK = 4096
@@ -78,6 +81,12 @@ class Plan:
     names : tuple of str
         The swept paths as the user wrote them (the grid's dimensions, the samples'
         coordinates).
+    scenario : str
+        The scenario's name: ``rigid-body`` (members are trajectories), or a built-in whose
+        members are its summary's numbers.
+    outputs : tuple of str
+        For a built-in: the summary's numbers stored per member (:func:`summary_numbers`
+        of a first run).
     time : ndarray or None
         The sample times every member shares (s), or None when they differ (a swept
         ``h``, ``t_end`` or ``record_every``, an adaptive method): then only the summary
@@ -94,6 +103,8 @@ class Plan:
     source_hash: str
     time: np.ndarray | None
     names: tuple[str, ...] = ()
+    scenario: str = "rigid-body"
+    outputs: tuple[str, ...] = ()
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -169,34 +180,52 @@ def dim_path(path: tuple) -> str:
 # Reading the scenario.
 
 
-def load_scenario(scenario: Any) -> tuple[dict, str, str, Any]:
-    """``(options, source, sha256, sweep)`` of a scenario file, a model or a mapping.
+def load_scenario(scenario: Any) -> tuple[str, dict, str, str, Any]:
+    """``(name, options, source, sha256, sweep)`` of what :func:`make_plan` was given.
 
-    ``sweep`` is the file's ``[sweep]`` section (:class:`tumble.scenarios.files.Sweep`), or
-    None.
+    A ``rigid-body`` file, model or mapping gives the options as written; a built-in
+    scenario's name (or a file of one) gives every option, its defaults filled in, since a
+    swept path may point into a default (``spins.0.1``). ``sweep`` is the file's ``[sweep]``
+    section (:class:`tumble.scenarios.files.Sweep`), or None. The hash is the file's bytes',
+    the options' JSON, or for a built-in name its module's source.
     """
     if isinstance(scenario, rigid_body.Options):
         options = scenario.model_dump(mode="json", exclude_unset=True)
-        return options, "<options>", _hash(json.dumps(options, sort_keys=True).encode()), None
+        return RIGID, options, "<options>", _json_hash(options), None
     if isinstance(scenario, Mapping):
         options = dict(validate(rigid_body.OPTIONS, dict(scenario), prefix="options")
                        .model_dump(mode="json", exclude_unset=True))  # fmt: skip
-        return options, "<options>", _hash(json.dumps(options, sort_keys=True).encode()), None
+        return RIGID, options, "<options>", _json_hash(options), None
     if isinstance(scenario, str | Path) and str(scenario).endswith(".toml"):
         path = Path(scenario)
         found = read(path)
-        if found.scenario not in SCENARIOS:
-            raise ValueError(
-                f"{path}: scenario = {found.scenario!r} cannot be swept; allowed: "
-                f"{', '.join(SCENARIOS)} (write the body as a rigid-body file: "
-                "examples/t-handle-parts.toml)"
-            )
-        return found.options, str(found.source), _hash(path.read_bytes()), found.sweep
+        options = found.options
+        if found.scenario != RIGID:
+            options = {**defaults(found.scenario), **options}
+        return found.scenario, options, str(found.source), _hash(path.read_bytes()), found.sweep
+    if isinstance(scenario, str) and scenario in registry.names() and scenario != RIGID:
+        module = Path(registry.get(scenario).__file__ or "")
+        return scenario, defaults(scenario), scenario, _hash(module.read_bytes()), None
     raise _checks.fail(
         "scenario", scenario,
-        "a scenario file (.toml) of scenario 'rigid-body', its options as a mapping, or a "
+        "a scenario file (.toml), a built-in scenario's name (tumble list; not 'rigid-body', "
+        "which needs a body), or the rigid-body options as a mapping or "
         "tumble.scenarios.rigid_body.Options",
     )  # fmt: skip
+
+
+def defaults(scenario: str) -> dict:
+    """A built-in scenario's options, each at its default (JSON types: lists, not tuples)."""
+    parameters = inspect.signature(registry.get(scenario).run).parameters.values()
+    return {
+        p.name: json.loads(json.dumps(p.default))
+        for p in parameters
+        if p.kind is inspect.Parameter.KEYWORD_ONLY and p.default is not inspect.Parameter.empty
+    }
+
+
+def _json_hash(options: dict) -> str:
+    return _hash(json.dumps(options, sort_keys=True).encode())
 
 
 def _hash(data: bytes) -> str:
@@ -209,12 +238,20 @@ def _hash(data: bytes) -> str:
 _SECTIONS = {"initial": rigid_body.Initial}
 
 
-def resolve(key: Any, options: dict) -> tuple:
+def resolve(key: Any, options: dict, scenario: str = RIGID) -> tuple:
     """The full path of a dotted ``key`` (short forms expanded); a ValueError if unknown."""
     if not isinstance(key, str) or not key or any(not part for part in key.split(".")):
         raise _checks.fail("grid key", key, "a dotted option path such as 'h' or 'omega0.1'")
     parts: list[Any] = [int(p) if p.isdigit() else p for p in key.split(".")]
     head = parts[0]
+    if scenario != RIGID:
+        allowed = sorted(options_model(scenario).model_fields)
+        if head not in allowed:
+            raise ValueError(
+                f"grid key {key!r} is not an option path of scenario {scenario!r}; allowed: "
+                f"{', '.join(allowed)} (and their entries, as spins.0.1)"
+            )
+        return tuple(parts)
     if head in rigid_body.Options.model_fields:
         return tuple(parts)
     for section, model in _SECTIONS.items():
@@ -270,11 +307,14 @@ def _check_path(key: str, path: tuple, options: dict) -> None:
             return
 
 
-def _check_value(key: str, path: tuple, value: Any, options: dict) -> None:
+def _check_value(key: str, path: tuple, value: Any, options: dict, scenario: str) -> None:
     trial = copy.deepcopy(options)
     try:
         set_path(trial, path, value)
-        validate(rigid_body.OPTIONS, trial, prefix="options")
+        if scenario == RIGID:
+            validate(rigid_body.OPTIONS, trial, prefix="options")
+        else:
+            check_options(scenario, trial)
     except (ValueError, TypeError, IndexError) as error:
         raise ValueError(f"grid key {key!r}, value {short_repr(value)}: {error}") from None
 
@@ -286,21 +326,21 @@ def _plain(value: Any) -> Any:
     return value
 
 
-def _check_column(key: str, path: tuple, values: list, options: dict) -> None:
+def _check_column(key: str, path: tuple, values: list, options: dict, scenario: str) -> None:
     """Check each distinct value; a column of numbers is checked by its extremes and type."""
     numbers = [v for v in values if isinstance(v, int | float) and not isinstance(v, bool)]
     if len(numbers) == len(values) and len(values) > 2:
         for value in values:
             if not math.isfinite(value):
-                _check_value(key, path, value, options)
-        _check_value(key, path, min(values), options)
-        _check_value(key, path, max(values), options)
+                _check_value(key, path, value, options, scenario)
+        _check_value(key, path, min(values), options, scenario)
+        _check_value(key, path, max(values), options, scenario)
         return
     seen: list = []
     for value in values:
         if value not in seen:
             seen.append(value)
-            _check_value(key, path, value, options)
+            _check_value(key, path, value, options, scenario)
 
 
 def make_plan(
@@ -315,7 +355,7 @@ def make_plan(
     Parameters
     ----------
     scenario : str, Path, mapping or tumble.scenarios.rigid_body.Options
-        A ``rigid-body`` scenario file, or its options.
+        A scenario file, a built-in scenario's name, or the ``rigid-body`` options.
     grid : mapping of str to sequence, optional
         Option path → values; the values multiply. Default: the file's ``[sweep.grid]``.
     samples : mapping of str to sequence, sequence of mappings, or DataFrame, optional
@@ -335,7 +375,7 @@ def make_plan(
         ``grid`` and ``samples``, or columns of different lengths: naming the key, the value
         and what is allowed.
     """
-    options, source, digest, section = load_scenario(scenario)
+    name, options, source, digest, section = load_scenario(scenario)
     if grid is None and samples is None and section is not None and section.grid:
         grid = grid_from_table(section.grid)
         chunk = section.chunk if chunk is None else chunk
@@ -352,10 +392,10 @@ def make_plan(
         )  # fmt: skip
     paths, values = [], []
     for key, given in columns.items():
-        path = resolve(key, options)
+        path = resolve(key, options, name)
         _check_path(key, path, options)
         listed = _values(key, given)
-        _check_column(key, path, listed, options)
+        _check_column(key, path, listed, options, name)
         paths.append(path)
         values.append(listed)
     if samples is not None and len({len(v) for v in values}) > 1:
@@ -365,11 +405,11 @@ def make_plan(
     if samples is None and len({dim_path(p) for p in paths}) < len(paths):
         raise _checks.fail("grid", list(columns), "each option path at most once")
     shape = (len(values[0]),) if samples is not None else tuple(map(len, values))
-    time = shared_time(options, paths, values)
+    time = shared_time(options, paths, values) if name == RIGID else None
     per_member = SUMMARY_BYTES + (0 if time is None else len(time) * SERIES_BYTES)
     chunks = _chunks(shape, _chunk(chunk, per_member))
     return Plan(options, dims, tuple(paths), tuple(values), samples is not None, chunks,
-                source, digest, time, tuple(columns))  # fmt: skip
+                source, digest, time, tuple(columns), name)  # fmt: skip
 
 
 def _columns(samples: Any) -> dict:

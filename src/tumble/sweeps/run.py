@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import copy
+import dataclasses
 import itertools
 import logging
 import os
@@ -12,8 +14,10 @@ from pathlib import Path
 from typing import Any
 
 from tumble import _checks
-from tumble.sweeps.members import run_members
-from tumble.sweeps.plan import Plan, make_plan
+from tumble.scenarios import registry
+from tumble.scenarios.files import check_options
+from tumble.sweeps.members import run_members, summary_numbers
+from tumble.sweeps.plan import RIGID, Plan, make_plan, set_path
 from tumble.sweeps.store import check_existing, pending_tasks, write_region, write_template
 
 log = logging.getLogger(__name__)
@@ -78,7 +82,9 @@ def sweep(
     Parameters
     ----------
     scenario : str, Path, mapping or tumble.scenarios.rigid_body.Options
-        A ``rigid-body`` scenario file (``.toml``), or its options.
+        A scenario file (``.toml``), a built-in scenario's name (``"t-handle"``), or the
+        ``rigid-body`` options. A ``rigid-body`` member stores its trajectory and summary
+        variables; a built-in's its summary's numbers (:mod:`tumble.sweeps.store`).
     grid : mapping of str to sequence, optional
         Dotted option path → values (``{"omega0.1": [0.01, 0.02], "method": ["rkmk4"]}``);
         the values multiply and each path is a dimension of the output
@@ -115,7 +121,7 @@ def sweep(
     import xarray as xr
     from distributed import as_completed
 
-    plan = make_plan(scenario, grid, samples, chunk=chunk)
+    plan = _probed(make_plan(scenario, grid, samples, chunk=chunk))
     store = str(store)
     exists = Path(store).exists()
     if exists and not resume:
@@ -146,6 +152,24 @@ def sweep(
             if progress is not None:
                 progress(done, plan.size)
     return xr.open_zarr(store)
+
+
+def _probed(plan: Plan) -> Plan:
+    """A built-in's plan with its outputs: the numbers of its first member's summary.
+
+    The first member runs once here, before the template is written (the store's variables
+    are the summary's numbers); its task runs it again on a worker.
+    """
+    if plan.scenario == RIGID:
+        return plan
+    log.info("sweep: running the first member here to name the summary's numbers")
+    options = copy.deepcopy(plan.options)
+    for path, values in zip(plan.paths, plan.values, strict=True):
+        set_path(options, path, values[0])
+    summary = registry.get(plan.scenario).run(**check_options(plan.scenario, options)).summary
+    taken = {*plan.dims, *plan.names, "member", "done", "wall_time"}  # a swept option's echo
+    numbers = [name for name in summary_numbers(summary) if name not in taken]
+    return dataclasses.replace(plan, outputs=tuple(numbers))
 
 
 def _key(token: str, task: tuple[int, ...]) -> str:

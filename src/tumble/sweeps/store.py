@@ -31,7 +31,7 @@ import numpy as np
 
 from tumble._version import __version__
 from tumble.sweeps.members import SERIES, SUMMARY
-from tumble.sweeps.plan import Plan, dim_path
+from tumble.sweeps.plan import RIGID, Plan, dim_path
 
 FORMAT: Literal[2] = 2
 """Zarr format: version 2 has consolidated metadata and string arrays in its specification."""
@@ -75,7 +75,7 @@ def template(plan: Plan):
                            chunks=(*chunks, n, *(3 for _ in extra)))  # fmt: skip
             attrs = {"units": units, "long_name": text}
             variables[name] = ((*plan.dims, "time", *extra), data, attrs)
-    for name, (dtype, units, text) in SUMMARY.items():
+    for name, (dtype, units, text) in _summary(plan).items():
         fill = np.nan if dtype.startswith("float") else 0
         data = da.full(shape, fill, dtype=dtype, chunks=chunks)
         variables[name] = (plan.dims, data, {"units": units, "long_name": text})
@@ -85,13 +85,22 @@ def template(plan: Plan):
     return xr.Dataset(variables, coords=_coords(plan), attrs=attributes(plan))
 
 
+def _summary(plan: Plan) -> dict:
+    """The per-member variables: a trajectory's summary, or a built-in's summary numbers."""
+    if plan.scenario == RIGID:
+        return SUMMARY
+    where = f"summary.json of scenario {plan.scenario!r} (units as documented there)"
+    numbers = {name: ("float64", "", f"{name} from {where}") for name in plan.outputs}
+    return {**numbers, "wall_time": SUMMARY["wall_time"]}
+
+
 def attributes(plan: Plan) -> dict:
     """Provenance: the tumble version, the scenario and its hash, the grid, the options."""
     return {
         "title": "tumble sweep",
         "Conventions": "CF-1.8",
         "tumble_version": __version__,
-        "scenario": "rigid-body",
+        "scenario": plan.scenario,
         "scenario_source": plan.source,
         "scenario_sha256": plan.source_hash,
         "grid": plan.grid_attr(),
