@@ -391,6 +391,10 @@ def sweep(
         console.print(table)
         two = len(swept_dims(dataset)) == 2 and "flip_period" in dataset
         name = draw or ("flip_period" if two else None)
+        if draw is None and name is not None and dataset[name].isnull().all():
+            console.print("no flip period measured (fewer than three crossings): no map; run "
+                          "longer, or choose another variable with --map")  # fmt: skip
+            name = None
         if name is not None:
             picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
             console.print(f"map: {picture}", highlight=False)
