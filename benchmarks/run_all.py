@@ -31,6 +31,7 @@ BENCHMARKS = [
     "bench_structural",
     "bench_ode",
     "bench_import",
+    "bench_sweep",
 ]
 
 

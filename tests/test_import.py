@@ -75,6 +75,8 @@ def test_every_public_name_resolves_to_its_module_object(name):
     origin = (
         "tumble.ode"
         if name in {"ButcherTableau", "OdeResult", "Status", "solve"}
+        else "tumble.sweeps"
+        if name == "sweep"
         else "tumble.rigid"
     )
     if name in {"exact", "mass", "meshes", "so3", "structural"}:

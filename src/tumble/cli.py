@@ -395,6 +395,82 @@ def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool)
     console.print(f"plots: {path}, {folder / 'schemes_vs_exact.png'}", highlight=False)
 
 
+Grid = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--grid",
+        help="PATH=start:stop:count or PATH=a,b,c (repeat; the values multiply). "
+        "Default: the file's sweep.grid table.",
+    ),
+]
+
+
+@app.command()
+def sweep(
+    file: Annotated[Path, typer.Argument(help="A scenario file (.toml).")],
+    grid: Grid = None,
+    out: Annotated[Path, typer.Option(help="The Zarr store to write (a folder).")] = Path(
+        "runs/sweep.zarr"
+    ),
+    scheduler: Annotated[
+        str | None, typer.Option(help="A Dask scheduler's address (default: a local cluster).")
+    ] = None,
+    resume: Annotated[
+        bool, typer.Option(help="Complete an existing store of this sweep.")
+    ] = False,
+    chunk: Annotated[int | None, typer.Option(help="Members per task.")] = None,
+    timeout: Annotated[float, typer.Option(help="Seconds to wait for --scheduler.")] = 10.0,
+    draw: Annotated[
+        str | None,
+        typer.Option(
+            "--map",
+            help="Draw this summary variable over the two swept dimensions: flip_period "
+            "(default), energy_error, wall_time, status, n_steps.",
+        ),
+    ] = None,
+) -> None:
+    """Run a scenario over a grid of options on Dask, into one Zarr store."""
+    from tumble.sweeps import sweep as run_sweep
+    from tumble.sweeps.picture import draw_map, swept_dims
+    from tumble.sweeps.text import parse_values
+
+    with _reported():
+        values = {}
+        for item in grid or []:
+            key, sign, text = item.partition("=")
+            if not sign:
+                raise ValueError(f"--grid {item!r}: must be PATH=VALUES, e.g. omega0.1=0:0.1:5")
+            values[key.strip()] = parse_values(key.strip(), text)
+        bar = Progress(TextColumn("sweep"), BarColumn(), TextColumn("{task.completed}/"
+                       "{task.total} members"), TimeElapsedColumn(), console=console,
+                       disable=not console.is_terminal)  # fmt: skip
+        with bar:
+            task = bar.add_task("members", total=None)
+            dataset = run_sweep(
+                str(file), values or None, client=scheduler, store=out, chunk=chunk,
+                resume=resume, timeout=timeout,
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
+            )  # fmt: skip
+        done = dataset["done"].values
+        table = Table(title=f"sweep: {out}", box=None, show_header=False)
+        table.add_row("members", f"{done.size} ({' x '.join(map(str, done.shape))})")
+        if "status" in dataset:
+            status = dataset["status"].values
+            table.add_row("reached t_end", str(int((status == 0).sum())))
+            table.add_row("stopped (failed)", str(int((status < 0).sum())))
+        table.add_row("wall time of the members", f"{float(dataset['wall_time'].sum()):.3g} s")
+        console.print(table)
+        two = len(swept_dims(dataset)) == 2 and "flip_period" in dataset
+        name = draw or ("flip_period" if two else None)
+        if draw is None and name is not None and dataset[name].isnull().all():
+            console.print("no flip period measured (fewer than three crossings): no map; run "
+                          "longer, or choose another variable with --map")  # fmt: skip
+            name = None
+        if name is not None:
+            picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
+            console.print(f"map: {picture}", highlight=False)
+
+
 @app.command()
 def view(
     run_dir: Annotated[Path, typer.Argument(help="A run folder written by `tumble run`.")],

@@ -121,7 +121,7 @@ BAD_FILES = {
     "unknown top-level key": (
         T_HANDLE + "h = 0.01\n",
         "h is not a top-level key of a scenario file; allowed: description, options, "
-        "outputs, scenario (a scenario's options go under [options])",
+        "outputs, scenario, sweep (a scenario's options go under [options])",
     ),
     "unknown option": (
         T_HANDLE + "[options]\nspinz = []\n",
