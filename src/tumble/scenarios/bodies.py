@@ -289,10 +289,13 @@ class Composite(Section):
         return "composite (" + " + ".join(part.label() for part in self.parts) + ")"
 
 
-Body = _union(
-    {"<primitive>": Primitive, "<mesh>": MeshBody, "<composite>": Composite},
-    "the body needs shape (a primitive), parts (a composite) or mesh (a mesh file)",
-)
+if TYPE_CHECKING:  # as Part above
+    Body = Cylinder | Box | Sphere | Torus | HexPrism | MeshBody | Composite
+else:
+    Body = _union(
+        {"<primitive>": Primitive, "<mesh>": MeshBody, "<composite>": Composite},
+        "the body needs shape (a primitive), parts (a composite) or mesh (a mesh file)",
+    )
 
 
 __all__ = [
