@@ -29,6 +29,10 @@ ERRORS = (("error", "‖R(T) − R_ref(T)‖_F"), ("energy", "max |E − E₀| /
 """The columns: which error, and its axis title."""
 FLOOR = 1e-17
 """Errors at or below this (exact to round-off) are drawn here, on the log axis."""
+CEILING = 10.0
+"""Errors above this are not drawn: an attitude error ‖R − R_ref‖_F of a rotation is at most
+2√3, so beyond it (and an energy error of 1000 %) the run has diverged, and one such point
+would squeeze every other curve into a sliver of the axis."""
 FLAG = "#d62728"
 """The colour of a method that contradicts its declaration."""
 PALETTE = (
@@ -57,7 +61,7 @@ def pareto_front(seconds: Sequence[float], errors: Sequence[float]) -> np.ndarra
     return np.array(front, dtype=int)
 
 
-def report_figure(rows: Sequence[dict], *, title: str):
+def report_figure(rows: Sequence[dict]):
     """The 2 × 2 work–precision figure (see the module docstring).
 
     Parameters
@@ -66,8 +70,6 @@ def report_figure(rows: Sequence[dict], *, title: str):
         :func:`tumble.report_card.plot_data`: per method ``name``, ``setting`` (``"h"`` or
         ``"rtol"``), ``flagged``, ``why`` and ``sweeps`` (per problem ``seconds``,
         ``error``, ``energy``, ``settings``, ``steps``).
-    title : str
-        The page's title.
 
     Returns
     -------
@@ -93,7 +95,7 @@ def report_figure(rows: Sequence[dict], *, title: str):
             for j, (key, axis_title) in enumerate(ERRORS, start=1):
                 seconds = np.asarray(data["seconds"], float)
                 error = np.asarray(data[key], float)
-                shown = np.isfinite(error) & np.isfinite(seconds)
+                shown = np.isfinite(error) & np.isfinite(seconds) & (error <= CEILING)
                 y = np.maximum(error[shown], FLOOR)
                 x = seconds[shown]
                 custom = [
@@ -121,8 +123,10 @@ def report_figure(rows: Sequence[dict], *, title: str):
         ys = [p[1] for p in points]
         front = pareto_front(xs, ys)
         figure.add_scatter(
-            x=[xs[k] for k in front], y=[ys[k] for k in front], mode="lines",
-            line={"color": "black", "dash": "dash", "width": 1, "shape": "hv"},
+            x=[xs[k] for k in front], y=[ys[k] for k in front], mode="lines+markers",
+            line={"color": "black", "dash": "dash", "width": 2.5, "shape": "hv"},
+            marker={"symbol": "circle-open", "size": 13, "color": "black",
+                    "line": {"width": 2}},
             name="Pareto front", legendgroup="pareto", showlegend=(i, j) == (1, 1),
             customdata=[points[k][2] for k in front],
             hovertemplate="<b>Pareto front: %{customdata[0]}</b><br>%{customdata[1]}"
@@ -136,11 +140,10 @@ def report_figure(rows: Sequence[dict], *, title: str):
             figure.update_yaxes(type="log", title_text=axis_title, row=i, col=j,
                                 exponentformat="power")  # fmt: skip
     figure.update_layout(
-        title={"text": title},
         height=900,
         hovermode="closest",
         legend={"title": {"text": "method (click to hide)"}, "font": {"size": 11}},
-        margin={"l": 70, "r": 20, "t": 80, "b": 60},
+        margin={"l": 70, "r": 20, "t": 40, "b": 60},
         template="plotly_white",
     )
     return figure
@@ -148,7 +151,7 @@ def report_figure(rows: Sequence[dict], *, title: str):
 
 def write_html(path: str | Path, rows: Sequence[dict], *, title: str) -> Path:
     """Write the page: the contradictions above :func:`report_figure`, plotly.js inlined."""
-    figure = report_figure(rows, title=title)
+    figure = report_figure(rows)
     page = figure.to_html(include_plotlyjs=True, full_html=True, div_id=DIV_ID,
                           config={"displaylogo": False, "responsive": True})  # fmt: skip
     flagged = [row for row in rows if row["flagged"]]
