@@ -80,6 +80,7 @@ def test_measured_invariants_agree_with_the_declared_ones(numbers, name):
             assert str(row["forced_energy_law"].values) in ("round-off", "bounded")
     if "casimir" in method.conserves:
         assert float(row["casimir_max"]) <= report_card.ROUND_OFF
+        assert str(row["casimir_law"].values) == "round-off"
     if "orthogonality" in method.conserves:
         assert float(row["orthogonality_max"]) <= report_card.ROUND_OFF
     assert str(row["contradictions"].values) == ""
@@ -141,16 +142,16 @@ def test_a_wrong_conservation_claim_is_flagged(monkeypatch):
     assert card.results[0].free.energy_max > report_card.ROUND_OFF
 
 
-def test_energy_law_reads_bounded_drift_and_round_off():
+def test_growth_law_reads_bounded_drift_and_round_off():
     t = np.linspace(0.0, 1000.0, 2001)
     drift = 1.0 + 1e-6 * t
     bounded = 1.0 + 1e-4 * np.sin(t)
     flat = 1.0 + 1e-15 * np.cos(t)
-    slope, largest, law = report_card.energy_law(t, drift)
+    slope, largest, law = report_card.growth_law(t, drift)
     assert law == "drift" and abs(slope - 1) < 0.01 and largest == pytest.approx(1e-3)
-    assert report_card.energy_law(t, bounded)[2] == "bounded"
-    assert report_card.energy_law(t, flat)[2] == "round-off"
-    assert report_card.energy_law(t, 1.0 + 1e-6 * t**2)[2] == "grows"
+    assert report_card.growth_law(t, bounded)[2] == "bounded"
+    assert report_card.growth_law(t, flat)[2] == "round-off"
+    assert report_card.growth_law(t, 1.0 + 1e-6 * t**2)[2] == "grows"
 
 
 def test_pareto_front_keeps_only_the_undominated_points():

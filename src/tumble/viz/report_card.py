@@ -51,13 +51,12 @@ def pareto_front(seconds: Sequence[float], errors: Sequence[float]) -> np.ndarra
     >>> pareto_front([1.0, 2.0, 3.0, 4.0], [1e-3, 1e-2, 1e-5, 1e-5]).tolist()
     [0, 2]
     """
-    seconds, errors = np.asarray(seconds, float), np.asarray(errors, float)
-    order = np.lexsort((errors, seconds))
+    cost, error = np.asarray(seconds, float), np.asarray(errors, float)
     front, best = [], math.inf
-    for k in order:
-        if np.isfinite(errors[k]) and errors[k] < best:
+    for k in np.lexsort((error, cost)):
+        if np.isfinite(error[k]) and error[k] < best:
             front.append(int(k))
-            best = errors[k]
+            best = error[k]
     return np.array(front, dtype=int)
 
 
