@@ -59,7 +59,7 @@ from pathlib import Path
 
 import numpy as np
 
-from tumble import _checks, exact, so3
+from tumble import _checks, exact, mass, so3
 from tumble._atomic import atomic_write
 from tumble._progress import progress_bar
 from tumble._version import __version__
@@ -152,8 +152,6 @@ def problems() -> list[Problem]:
     """P1, the T-handle's three spins, the near-separatrix spin and the forced body."""
     p1_body = RigidBody(1.0, P1_INERTIA, allow_unphysical=True)
     p1_omega = P1_L0 / P1_INERTIA
-    from tumble import mass
-
     handle = RigidBody.from_mass_properties(mass.t_handle())
     spins = [
         Problem(f"T-handle ω₀={tuple(spin)}", handle, np.array(spin, float), PROBLEM_T)
@@ -1057,7 +1055,14 @@ def _number(value: float, digits: int = 2) -> str:
         return "—"
     if math.isinf(value):
         return "∞" if value > 0 else "−∞"
+    if abs(value) >= 100:
+        return f"{value:.0f}"
     return f"{value:.{digits}g}" if abs(value) >= 1e-3 or value == 0 else f"{value:.1e}"
+
+
+def _law(law: str, slope: float) -> str:
+    """``drift (0.99)``: a law with its slope; round-off and failed runs have none."""
+    return law if law in ("round-off", "failed") else f"{law} ({_number(slope)})"
 
 
 def _sci(value: float) -> str:
@@ -1155,14 +1160,11 @@ def markdown(card: ReportCard) -> str:
             for c in CLAIMS
             if c in r.row.claims
         )
-        forced = (
-            "—" if r.forced is None
-            else f"{r.forced.energy_law} ({_number(r.forced.energy_slope)})"
-        )  # fmt: skip
+        forced = "—" if r.forced is None else _law(r.forced.energy_law, r.forced.energy_slope)
         lines.append(
-            f"| {r.row.name} | {claims or '—'} | {r.free.energy_law} "
-            f"({_number(r.free.energy_slope)}) | {_sci(r.free.energy_max)} | {forced} | "
-            f"{r.free.casimir_law} ({_number(r.free.casimir_slope)}) | "
+            f"| {r.row.name} | {claims or '—'} | "
+            f"{_law(r.free.energy_law, r.free.energy_slope)} | {_sci(r.free.energy_max)} | "
+            f"{forced} | {_law(r.free.casimir_law, r.free.casimir_slope)} | "
             f"{_sci(r.free.casimir_max)} | {_sci(r.free.orthogonality_max)} | "
             f"{_sci(r.free.quaternion_max)} |"
         )
@@ -1206,7 +1208,9 @@ def markdown(card: ReportCard) -> str:
     lines += [
         "",
         "The interactive work–precision diagrams (orientation and energy error against wall "
-        "time, the Pareto front marked) are in `report.html`; the raw numbers in `report.nc`.",
+        "time, the Pareto front marked) are in `report.html`, the raw numbers in `report.nc`, "
+        "both written beside `report.md` by `tumble report` (`make report` keeps them in "
+        "`runs/report/` and copies this page to `docs/report.md`).",
         "",
     ]
     return "\n".join(lines)
