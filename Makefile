@@ -8,7 +8,7 @@ BENCH_STAMP := $(VENV)/.installed-bench
 DEMO ?= t-handle
 RUN_DIR ?= runs/$(DEMO)
 
-.PHONY: demo test browser bench report lint format clean
+.PHONY: demo test browser bench report lint format clean docs
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -45,6 +45,10 @@ bench: $(BENCH_STAMP)
 report: $(BENCH_STAMP)
 	OPENBLAS_NUM_THREADS=1 $(BIN)/tumble report --out runs/report
 	cp runs/report/report.md docs/report.md
+
+# The documentation site (Sphinx, docs/conf.py) in build/docs/html/index.html; warnings are errors.
+docs: $(STAMP)
+	$(BIN)/sphinx-build -W --keep-going -b html -d build/docs/doctrees docs build/docs/html
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -100,7 +100,23 @@ def long_run_energy() -> Path:
     return shrink(source, "long_run_energy.png")
 
 
+def flip_map() -> Path:
+    """docs/sweeps.md's picture: examples/flip_map.py on a 24 x 24 grid (a local cluster)."""
+    import importlib.util
+
+    path = Path(__file__).parents[1] / "examples" / "flip_map.py"
+    spec = importlib.util.spec_from_file_location("flip_map", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    work = Path(tempfile.mkdtemp())
+    module.run(work / "flip-map.zarr", work / "flip-map.png", size=24)
+    return shrink(work / "flip-map.png", "flip_map.png", width=1200)
+
+
 def main() -> None:
+    if sys.argv[1:] == ["flip_map"]:  # only the sweep's picture
+        flip_map()
+        return
     IMAGES.mkdir(exist_ok=True)
     work = Path(tempfile.mkdtemp())
 
@@ -135,6 +151,7 @@ def main() -> None:
     long_run_energy()
     top = folder("spinning-top", scenarios.get("spinning-top").run(), animation=False)
     shrink(top / "top.png", "top.png")
+    flip_map()
 
 
 if __name__ == "__main__":

@@ -49,6 +49,9 @@ REFUSALS = [
     ("callables", lambda: _checks.callables("events", 42), "events", 42),
     ("callables", lambda: _checks.callables("events", "g"), "events", "g"),
     ("callables", lambda: _checks.callables("events", [print, 3]), "events[1]", 3),
+    ("sample_times", lambda: _checks.sample_times("t_eval", [0, 2, 1], 0, 3), "t_eval", [0, 2, 1]),
+    ("sample_times", lambda: _checks.sample_times("t_eval", [0, 4], 0, 3), "t_eval[1]", 4.0),
+    ("sample_times", lambda: _checks.sample_times("t_eval", [], 0, 3), "t_eval", []),
 ]
 
 
@@ -121,3 +124,27 @@ INFINITE = {
 @pytest.mark.parametrize(("call", "name"), INFINITE.values(), ids=list(INFINITE))
 def test_inf_is_refused_where_a_positive_number_is_asked(call, name):
     assert _message(call).startswith(f"{name}=inf is not allowed"), _message(call)
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (
+            lambda: _checks.array("y0", ["a", "b"]),
+            "y0=['a', 'b'] is not allowed: must be an array of numbers, every entry finite",
+        ),
+        (
+            lambda: _checks.array("x0", [0.0, NAN, 1.0], shape=(3,), unit="m"),
+            "x0[1]=nan is not allowed: must be finite (m)",
+        ),
+        (
+            lambda: _checks.array("E", [[1.0, -2.0]], positive=True),
+            "E[0, 1]=-2.0 is not allowed: must be finite and > 0",
+        ),
+    ],
+    ids=["strings", "one-entry", "one-entry-positive"],
+)
+def test_array_says_what_it_wants_of_the_whole_and_of_one_entry(call, message):
+    # Issue 18, item 11: string entries in y0 read "must be every entry finite"; one bad
+    # entry read "x0[1]=nan ... must be of shape (3,), finite", the shape of the whole.
+    assert _message(call) == message

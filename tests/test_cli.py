@@ -222,6 +222,7 @@ def test_mass_names_the_command_line_option_for_an_inside_out_mesh(tmp_path):
     path = meshes.save(mesh, tmp_path / "inside.stl")
     result = runner.invoke(app, ["mass", str(path), "--density", "1"])
     assert result.exit_code == 2 and "--fix-inside-out" in result.output
+    assert "inside.stl" in result.output and "Trimesh" not in result.output  # the file, by name
     fixed = runner.invoke(app, ["mass", str(path), "--density", "1", "--fix-inside-out"])
     assert fixed.exit_code == 0 and "note:" in fixed.output
     assert float(fixed.output.split(" kg ")[1].split()[0]) == pytest.approx(6.0)

@@ -398,3 +398,27 @@ def test_from_mesh_refuses_a_non_mesh():
 def test_from_mesh_refuses_bad_density():
     with pytest.raises(ValueError, match=r"density=-1 is not allowed: must be finite and > 0"):
         meshes.from_mesh(meshes.box([1.0, 1.0, 1.0]), density=-1)
+
+
+@pytest.mark.parametrize(
+    ("build", "message"),
+    [
+        (
+            lambda: mass.sphere(1e200, density=1e200),
+            r"radius=1e\+200 is not allowed: must be such that the mass and the moments of "
+            r"inertia are finite and > 0 \(m\); with density=1e\+200 kg/m³",
+        ),
+        (lambda: mass.cylinder(1e200, 1.0, density=1.0), r"radius=1e\+200 is not allowed"),
+        (lambda: mass.torus(1e200, 1.0, mass=1.0), r"major_radius=1e\+200 .*and mass=1\.0 kg"),
+        (lambda: mass.hex_prism(1.0, 1e300, density=1e10), r"length=1e\+300 is not allowed"),
+        (lambda: mass.box([1e200, 1.0, 1.0], density=1.0), r"extents\[0\]=1e\+200 is not all"),
+        (lambda: mass.sphere(1e-200, density=1.0), r"radius=1e-200 .*the mass is 0 kg"),
+        (lambda: mass.sphere(1e-170, mass=1.0), r"radius=1e-170 .*a moment of inertia is 0 kg m²"),
+    ],
+    ids=["sphere", "cylinder", "torus", "hex_prism", "box", "tiny-sphere", "tiny-inertia"],
+)
+def test_sizes_whose_mass_or_inertia_overflow_are_refused_by_name(build, message):
+    # Issue 18, item 11: mass.sphere(1e200, density=1e200) raised a raw OverflowError; other
+    # sizes gave numpy warnings and an inertia "not positive definite".
+    with pytest.raises(ValueError, match=message):
+        build()

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from tumble import meshes
+from tumble import _mesh_files, meshes
 
 # SPEC §4 closed forms for the torus R = 1, r = 0.5, rho = 1.
 TORUS_VOLUME = 2 * np.pi**2 * 1.0 * 0.5**2
@@ -221,3 +221,85 @@ def test_a_valid_stl_passes_the_check(tmp_path, binary):
     else:
         path.write_text(mesh.export(file_type="stl_ascii"))
     assert meshes.load(path).volume == pytest.approx(6.0)
+
+
+TETRAHEDRON_OBJ = "v {x} 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"
+
+
+@pytest.mark.parametrize("value", ["nan", "inf"])
+def test_a_file_with_non_finite_vertices_is_refused_naming_the_vertex(tmp_path, value):
+    # Issue 18, item 9: trimesh drops the faces of a NaN vertex, and the mesh was called open.
+    path = tmp_path / "tetrahedron.obj"
+    path.write_text(TETRAHEDRON_OBJ.format(x=value))
+    message = rf"must be a mesh file with finite vertex coordinates; vertex 0 is \[{value}, 0"
+    with pytest.raises(ValueError, match=message):
+        meshes.load(path)
+    with pytest.raises(ValueError, match=message):
+        meshes.from_mesh(path, density=1.0)
+
+
+def test_a_mesh_with_non_finite_vertices_is_refused_naming_the_vertex():
+    box = meshes.box([1.0, 1.0, 1.0])
+    vertices = box.vertices.copy()
+    vertices[3, 1] = np.nan
+    mesh = trimesh.Trimesh(vertices, box.faces, process=False)
+    with pytest.raises(
+        ValueError,
+        match=r"mesh_or_path=.* must be a mesh with finite vertex coordinates; vertex 3",
+    ):
+        meshes.from_mesh(mesh, density=1.0)
+
+
+@pytest.mark.parametrize("suffix", ["stl", "obj", "ply"])
+def test_a_closed_box_with_huge_coordinates_loads_closed(tmp_path, suffix):
+    # Issue 18, item 9: trimesh's merge of a box with 1e12 coordinates overflowed its integer
+    # keys and collapsed the box to one vertex, "open". 2**40 = 1.1e12 is exact in float32.
+    side = 2.0**41
+    path = meshes.save(meshes.box([side, side, side]), tmp_path / f"big.{suffix}")
+    mesh = meshes.load(path)
+    assert mesh.is_watertight and len(mesh.vertices) == 8
+    assert meshes.from_mesh(path, density=1.0).mass == side**3  # exact: powers of two
+
+
+def test_load_merges_the_vertices_an_stl_repeats(tmp_path):
+    # A binary STL stores each triangle's 3 corners: 36 for a box, 8 distinct.
+    mesh = meshes.load(meshes.save(meshes.box([1.0, 2.0, 3.0]), tmp_path / "box.stl"))
+    assert (len(mesh.vertices), len(mesh.faces), mesh.is_watertight) == (8, 12, True)
+
+
+@pytest.mark.parametrize("suffix", meshes.TEXT_FORMATS)
+def test_random_bytes_named_as_a_text_format_are_refused_as_not_text(tmp_path, suffix):
+    # Issue 18, item 9: trimesh's text sniffing needs an optional module (charset_normalizer)
+    # and the user read "the reader needs an optional module that is missing".
+    path = tmp_path / f"x.{suffix}"
+    path.write_bytes(np.random.default_rng(5).integers(0, 256, 3000, dtype=np.uint8).tobytes())
+    message = rf"must be a text {suffix} file; its byte \d+ \(0x[0-9a-f]{{2}}\) is not UTF-8"
+    with pytest.raises(ValueError, match=message):
+        meshes.load(path)
+
+
+def test_a_box_collapsed_by_trimeshs_merge_is_refused_with_that_cause():
+    # Issue 18, item 9: trimesh.Trimesh(vertices * 1e12, faces) merges the 8 corners into one
+    # (its int64 merge keys overflow); the mesh was called open, as if a face were missing.
+    box = meshes.box([1.0, 1.0, 1.0])
+    with np.errstate(invalid="ignore"):  # trimesh's own cast warning
+        collapsed = trimesh.Trimesh(box.vertices * 1e12, box.faces)
+    with pytest.raises(ValueError, match=r"face 0 has 1 distinct vertices.*process=False"):
+        meshes.from_mesh(collapsed, density=1.0)
+    whole = trimesh.Trimesh(box.vertices * 1e12, box.faces, process=False)
+    assert meshes.from_mesh(whole, density=1.0).mass == pytest.approx(1e36, rel=1e-12)
+
+
+def test_the_merge_joins_corners_closer_than_trimeshs_tolerance():
+    # Each triangle its own 3 corners, moved by up to 1e-10 m (< tol.merge = 1e-8 m): one
+    # closed box again, as trimesh's own merge would give. (Exporters round to 8 digits, so
+    # the merge is called directly.)
+    box = meshes.box([1.0, 2.0, 3.0])
+    noise = np.random.default_rng(1).uniform(-1e-10, 1e-10, (36, 3))
+    loose = trimesh.Trimesh(
+        box.triangles.reshape(-1, 3) + noise, np.arange(36).reshape(12, 3), process=False
+    )
+    assert len(np.unique(loose.vertices, axis=0)) == 36 and not loose.is_watertight
+    mesh = _mesh_files.merged(loose)
+    assert (len(mesh.vertices), mesh.is_watertight) == (8, True)
+    assert mesh.volume == pytest.approx(6.0, rel=1e-9)

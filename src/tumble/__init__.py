@@ -18,6 +18,9 @@ Rigid bodies
 :class:`Trajectory`                 what ``simulate`` returns
 :func:`simulate_batch`              many bodies at once (compiled, parallel); a
                                     :class:`BatchTrajectory`
+Sweeps
+:func:`sweep`                       one scenario over a grid of options, on Dask, into one
+                                    Zarr store (resumable)
 Modules
 :mod:`tumble.so3`                   rotations: exp/log, dexp, quaternions, Euler angles
 :mod:`tumble.mass`                  mass properties: primitives, composites
@@ -43,6 +46,7 @@ if TYPE_CHECKING:  # what static type checkers see; at run time __getattr__ impo
     from tumble import ode as ode
     from tumble import rigid as rigid
     from tumble import scenarios as scenarios
+    from tumble import sweeps as sweeps
     from tumble import viz as viz
     from tumble._version import __version__ as __version__
     from tumble.ode import ButcherTableau, OdeResult, Status, solve
@@ -60,6 +64,7 @@ if TYPE_CHECKING:  # what static type checkers see; at run time __getattr__ impo
         simulate,
         simulate_batch,
     )
+    from tumble.sweeps import sweep
 
 # The library never prints: it logs, and stays silent unless the application configures logging.
 logging.getLogger(__name__).addHandler(logging.NullHandler())
@@ -84,11 +89,25 @@ __all__ = [
     "simulate_batch",
     "so3",
     "solve",
+    "report",
     "structural",
+    "sweep",
 ]
 
 _SUBMODULES = frozenset(
-    {"exact", "io", "mass", "meshes", "ode", "rigid", "scenarios", "so3", "structural", "viz"}
+    {
+        "exact",
+        "io",
+        "mass",
+        "meshes",
+        "ode",
+        "rigid",
+        "scenarios",
+        "so3",
+        "structural",
+        "sweeps",
+        "viz",
+    }
 )
 """Modules reachable as ``tumble.<name>`` after a bare ``import tumble``."""
 _NAMES = {
@@ -110,6 +129,7 @@ _NAMES = {
         "tumble.rigid",
     ),
     "report": "tumble.report_card",
+    "sweep": "tumble.sweeps",
     "__version__": "tumble._version",
 }
 """Each public name and the module it comes from."""

@@ -127,9 +127,9 @@ def array(
     ...
     ValueError: x0=[0.0, 1.0] is not allowed: must be of shape (3,), every entry finite (m)
     """
-    wanted = "every entry finite and > 0" if positive else "every entry finite"
-    if shape is not None:
-        wanted = f"of shape {tuple(shape)}, {wanted}"
+    each = "finite and > 0" if positive else "finite"
+    whole = "an array of numbers" if shape is None else f"of shape {tuple(shape)}"
+    wanted = f"{whole}, every entry {each}"
     try:
         result = np.array(value, dtype=float)
     except (TypeError, ValueError):
@@ -142,7 +142,7 @@ def array(
             raise fail(name, value, wanted, unit)
         index = tuple(int(i) for i in np.argwhere(~good)[0])
         label = f"{name}[{', '.join(map(str, index))}]"
-        raise fail(label, float(result[index]), wanted.replace("every entry ", ""), unit)
+        raise fail(label, float(result[index]), each, unit)
     return result
 
 
@@ -218,3 +218,35 @@ def callables(name: str, value: object, remedy: str = "") -> list:
         if not callable(item):
             raise fail(f"{name}[{index}]", item, "a callable g(t, y)", remedy=remedy)
     return items
+
+
+def sample_times(name: str, value: ArrayLike, t0: float, t1: float) -> NDArray[np.float64]:
+    """``value`` as a 1-D float array of times, sorted (increasing) and within ``[t0, t1]``:
+    where a run is asked to sample its dense output (``t_eval``).
+
+    Examples
+    --------
+    >>> sample_times("t", [0.0, 2.0, 1.0], 0.0, 3.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: t=[0.0, 2.0, 1.0] is not allowed: must be increasing: t[2]=1.0 follows 2.0 (s)
+    >>> sample_times("t_eval", [0.5, 4.0], 0.0, 3.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: t_eval[1]=4.0 is not allowed: must be within the run, [0.0, 3.0] (s)
+    """
+    times = values(name, value, unit="s")
+    outside = np.flatnonzero((times < t0) | (times > t1))
+    if outside.size:
+        i = int(outside[0])
+        raise fail(f"{name}[{i}]", float(times[i]), f"within the run, [{t0!r}, {t1!r}]", "s")
+    steps = np.flatnonzero(np.diff(times) <= 0)
+    if steps.size:
+        i = int(steps[0]) + 1
+        raise fail(
+            name,
+            value,
+            f"increasing: {name}[{i}]={float(times[i])!r} follows {float(times[i - 1])!r}",
+            "s",
+        )
+    return times

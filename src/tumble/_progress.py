@@ -37,7 +37,7 @@ def announce_compilation(kernel: Any, what: str) -> None:
     """
     if not getattr(kernel, "signatures", True):
         log.info(
-            "preparing the compiled %s (numba compiles it the first time, about 10 s; later "
-            "runs load it from its cache)",
+            "preparing %s, compiled by numba (about 10 s the first time; later runs load it "
+            "from its cache)",
             what,
         )

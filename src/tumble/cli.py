@@ -299,10 +299,27 @@ def stability(
     steps: Annotated[int, typer.Option(help="Steps per run of the sweep.")] = 1000,
     out: Out = None,
     force: Force = False,
+    analyse: Annotated[
+        bool,
+        typer.Option(
+            "--analyse",
+            help="Instead of the sweep, the time-step analyser: amplification.png (spectral "
+            "radius, algorithmic damping and period error against Δt/T for every scheme) and "
+            "the beam's modes at --dt under each scheme.",
+        ),
+    ] = False,
+    dt: Annotated[
+        float | None,
+        typer.Option(help="Time step in s of --analyse's mode table (default T₁/20)."),
+    ] = None,
 ) -> None:
-    """The cantilever's time-step sweep: which scheme stays bounded at which Δt."""
+    """The cantilever's time-step sweep: which scheme stays bounded at which Δt (with
+    --analyse: each scheme's amplification against Δt/T and the beam's modes under it)."""
     from tumble.scenarios import beam
 
+    if analyse:
+        _analyse_steps(n_elements, dt, out or Path("runs") / "stability-analysis", force)
+        return
     with _reported(), _progress("stability sweep") as note:
         result = beam.stability(n_elements=n_elements, sweep_steps=steps)
         folder = _write(result, out or Path("runs") / "stability", force, False, note)
@@ -322,6 +339,136 @@ def stability(
         table.add_row(f"{factor:g}", f"{dt:.3g}", *cells)
     console.print(table)
     console.print(f"plot: {folder / 'stability_sweep.png'}", highlight=False)
+
+
+def _mode_cell(radius: float, value: float) -> str:
+    """A cell of the per-mode table: 'grows' where ρ > 1, '—' where there is no period."""
+    if radius > 1 + 1e-12:
+        return "[red]grows[/]"
+    return "—" if value != value else f"{abs(value) if abs(value) < 5e-4 else value:.3f}"
+
+
+def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool) -> None:
+    """``tumble stability --analyse``: the amplification picture and the per-mode tables."""
+    import numpy as np
+
+    from tumble import structural
+    from tumble.viz._figure import save
+    from tumble.viz.amplification import amplification_figure, comparison_figure
+
+    with _reported():
+        system = structural.cantilever(1.0, n_elements, 210e9, 7850.0, 0.01, 0.01, 1.0)
+        step = dt if dt is not None else 2 * np.pi / system.natural_frequencies(1)[0] / 20
+        table = structural.mode_table(system, step)
+        omega = 2 * np.pi * np.logspace(-2, 3, 241)
+        analyses = [structural.amplification(s, omega) for s in structural.SCHEMES.values()]
+    path = folder / "amplification.png"
+    if path.exists() and not force:
+        raise _fail(f"{path} exists; pass --force to overwrite it")
+    folder.mkdir(parents=True, exist_ok=True)
+    save(amplification_figure(analyses, title="amplification on ẍ + ω²x = 0 (SCHEMES' defaults)"),
+         path, dpi=110)  # fmt: skip
+    period = 2 * np.pi / table.omega[0]
+    with _reported():
+        runs = {name: structural.integrate(system, s, period / 100, n_steps=500, record_every=2)
+                for name, s in structural.SCHEMES.items()
+                if structural.critical_dt(system, s).dt > period / 100}  # fmt: skip
+        exact = structural.exact_response(system, next(iter(runs.values())).t)
+    title = (f"{n_elements}-element cantilever, 1 N step load from rest, Δt = T₁/100, "
+             "against exact_response")  # fmt: skip
+    save(comparison_figure(system, runs, exact, title=title), folder / "schemes_vs_exact.png",
+         dpi=110)  # fmt: skip
+
+    for name, values in (("algorithmic damping ratio ξ̄", table.damping_ratio),
+                         ("period elongation (T̄ − T)/T", table.period_elongation)):  # fmt: skip
+        grid = Table(title=f"{name}, cantilever with {n_elements} elements, Δt = {step:.4g} s "
+                     "(—: no period, the mode is damped out within a step)", box=None)  # fmt: skip
+        for column in ("mode", "ω [rad/s]", "Ω = ωΔt", *table.schemes):
+            grid.add_column(column.replace("-", "- "), justify="right", overflow="fold")
+        for k, w in enumerate(table.omega):
+            cells = [
+                _mode_cell(radius[k], v[k])
+                for radius, v in zip(table.spectral_radius, values, strict=True)
+            ]
+            grid.add_row(str(k + 1), f"{w:.4g}", f"{w * step:.3g}", *cells)
+        console.print(grid)
+    console.print(f"plots: {path}, {folder / 'schemes_vs_exact.png'}", highlight=False)
+
+
+Grid = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--grid",
+        help="PATH=start:stop:count or PATH=a,b,c (repeat; the values multiply). "
+        "Default: the file's sweep.grid table.",
+    ),
+]
+
+
+@app.command()
+def sweep(
+    file: Annotated[Path, typer.Argument(help="A scenario file (.toml).")],
+    grid: Grid = None,
+    out: Annotated[Path, typer.Option(help="The Zarr store to write (a folder).")] = Path(
+        "runs/sweep.zarr"
+    ),
+    scheduler: Annotated[
+        str | None, typer.Option(help="A Dask scheduler's address (default: a local cluster).")
+    ] = None,
+    resume: Annotated[
+        bool, typer.Option(help="Complete an existing store of this sweep.")
+    ] = False,
+    chunk: Annotated[int | None, typer.Option(help="Members per task.")] = None,
+    timeout: Annotated[float, typer.Option(help="Seconds to wait for --scheduler.")] = 10.0,
+    draw: Annotated[
+        str | None,
+        typer.Option(
+            "--map",
+            help="Draw this summary variable over the two swept dimensions: flip_period "
+            "(default), energy_error, wall_time, status, n_steps.",
+        ),
+    ] = None,
+) -> None:
+    """Run a scenario over a grid of options on Dask, into one Zarr store."""
+    from tumble.sweeps import sweep as run_sweep
+    from tumble.sweeps.picture import draw_map, swept_dims
+    from tumble.sweeps.text import parse_values
+
+    with _reported():
+        values = {}
+        for item in grid or []:
+            key, sign, text = item.partition("=")
+            if not sign:
+                raise ValueError(f"--grid {item!r}: must be PATH=VALUES, e.g. omega0.1=0:0.1:5")
+            values[key.strip()] = parse_values(key.strip(), text)
+        bar = Progress(TextColumn("sweep"), BarColumn(), TextColumn("{task.completed}/"
+                       "{task.total} members"), TimeElapsedColumn(), console=console,
+                       disable=not console.is_terminal)  # fmt: skip
+        with bar:
+            task = bar.add_task("members", total=None)
+            dataset = run_sweep(
+                str(file), values or None, client=scheduler, store=out, chunk=chunk,
+                resume=resume, timeout=timeout,
+                progress=lambda done, total: bar.update(task, completed=done, total=total),
+            )  # fmt: skip
+        done = dataset["done"].values
+        table = Table(title=f"sweep: {out}", box=None, show_header=False)
+        table.add_row("members", f"{done.size} ({' x '.join(map(str, done.shape))})")
+        if "status" in dataset:
+            status = dataset["status"].values
+            table.add_row("reached t_end", str(int((status == 0).sum())))
+            table.add_row("stopped (failed)", str(int((status < 0).sum())))
+        table.add_row("wall time of the members", f"{float(dataset['wall_time'].sum()):.3g} s")
+        console.print(table)
+        two = len(swept_dims(dataset)) == 2 and "flip_period" in dataset
+        name = draw or ("flip_period" if two else None)
+        if draw is None and name is not None and dataset[name].isnull().all():
+            console.print("no flip period measured (fewer than three crossings): no map; run "
+                          "longer, or choose another variable with --map")  # fmt: skip
+            name = None
+        if name is not None:
+            picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
+            console.print(f"map: {picture}", highlight=False)
 
 
 @app.command()
@@ -387,8 +534,9 @@ def mass_properties(
     with _reported(), warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            mesh = meshes.load(mesh_file)
-            properties = meshes.from_mesh(mesh, density=density, fix_inside_out=fix_inside_out)
+            properties = meshes.from_mesh(  # a refusal names the file, as given
+                mesh_file, density=density, fix_inside_out=fix_inside_out
+            )
         except ValueError as error:  # name the command-line option, not the argument
             message = str(error).replace("fix_inside_out=True", "--fix-inside-out")
             raise ValueError(message) from None

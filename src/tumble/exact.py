@@ -133,8 +133,8 @@ def sphere(t: ArrayLike, omega0: ArrayLike = (1.0, 0.0, 0.0)) -> np.ndarray:
     """Attitude of a torque-free isotropic body (I = c Id) starting at R(0) = Id.
 
     With I proportional to the identity ω is constant and R(t) = exp(t ω̃0): a rotation about
-    ω0 by the angle |ω0| t, by Rodrigues' formula
-    exp(θ k̃) = Id + sin θ k̃ + (1 − cos θ) k̃² with k = ω0/|ω0|, θ = |ω0| t.
+    ω0 by the angle ‖ω0‖ t, by Rodrigues' formula
+    exp(θ k̃) = Id + sin θ k̃ + (1 − cos θ) k̃² with k = ω0/‖ω0‖, θ = ‖ω0‖ t.
 
     Parameters
     ----------
@@ -168,7 +168,7 @@ def free_body(inertia: ArrayLike, omega0: ArrayLike, t: ArrayLike) -> np.ndarray
     """Body angular velocity ω(t) of the torque-free rigid body, exactly.
 
     Solves I ω̇ = (I ω) × ω, ω(0) = ω0. In the principal frame with A < B < C and the energy
-    2E = ω·Iω, the momentum |L|² = |Iω|² and Δ = |L|² − 2EB (Landau & Lifshitz §37):
+    2E = ω·Iω, the momentum ‖L‖² = ‖Iω‖² and Δ = ‖L‖² − 2EB (Landau & Lifshitz §37):
 
     * Δ > 0 (spin nearer the largest axis C): ω_A = a_A cn u, ω_B = σ a_B sn u,
       ω_C = σ a_C dn u, with a_A² = (2EC − L²)/(A(C − A)), a_B² = (2EC − L²)/(B(C − B)),
@@ -201,7 +201,7 @@ def free_body(inertia: ArrayLike, omega0: ArrayLike, t: ArrayLike) -> np.ndarray
     Raises
     ------
     ValueError
-        On bad input, or ω0 on the separatrix |L|² = 2EB (relative tolerance 1e-12) and not
+        On bad input, or ω0 on the separatrix ‖L‖² = 2EB (relative tolerance 1e-12) and not
         a steady spin: the motion takes infinite time to leave the middle axis (m = 1).
 
     References
@@ -222,7 +222,7 @@ def free_body(inertia: ArrayLike, omega0: ArrayLike, t: ArrayLike) -> np.ndarray
 def free_body_period(inertia: ArrayLike, omega0: ArrayLike) -> float:
     """Period of ω_body(t) of the torque-free body, s.
 
-    4K(m)/λ for an asymmetric body (m, λ as in `free_body`), 2π/|Ω| for a symmetric one. On
+    4K(m)/λ for an asymmetric body (m, λ as in `free_body`), 2π/abs(Ω) for a symmetric one. On
     the separatrix it is ``inf`` (the motion never returns; no error, test ``math.isinf``).
     Where ω is constant it is the limit of nearby periods: 2π/λ (small oscillations) for a
     spin about the largest or smallest axis, ``inf`` for a spin about the middle axis, a
@@ -259,10 +259,10 @@ def free_body_rotation(
     """Attitude R(t) (body to world) of the torque-free body, exactly.
 
     L = R0 I ω0 is constant. In the pole frame (q, r, p), p the axis the spin stays near,
-    R(t) = W Rz(φ) M(l) Pᵀ: l = Iω/|L|, M(l) = Rx(θ) Rz(ψ) the rotation with last row lᵀ
+    R(t) = W Rz(φ) M(l) Pᵀ: l = Iω/‖L‖, M(l) = Rx(θ) Rz(ψ) the rotation with last row lᵀ
     (Landau's Euler angles), P the pole axes in body coordinates, W = R0 P M(l(0))ᵀ, and
-    φ̇ = |L| (I_q ω_q² + I_r ω_r²)/(L_q² + L_r²) integrated in closed form,
-    φ = |L| t / I_p ± |L| (C − A)/(A C λ) [Π(−ν; am u | m)]₀ᵗ (docs/exact.md). A symmetric
+    φ̇ = ‖L‖ (I_q ω_q² + I_r ω_r²)/(L_q² + L_r²) integrated in closed form,
+    φ = ‖L‖ t / I_p ± ‖L‖ (C − A)/(A C λ) [Π(−ν; am u | m)]₀ᵗ (docs/exact.md). A symmetric
     body: R(t) = exp(t L̃/I⊥) R0 exp(Ωt ẽ_s); a constant ω: R(t) = R0 exp(t ω̃0).
 
     Parameters

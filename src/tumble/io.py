@@ -341,7 +341,6 @@ def load(path: str | Path) -> Run:
         If the folder or its ``summary.json`` / ``data.nc`` is missing or unreadable, or a file
         that ``summary.json`` lists is not in the folder.
     """
-    import xarray as xr
 
     if not isinstance(path, str | PathLike):
         raise _checks.fail("path", path, "a run folder or its data.nc, as a str or Path")
@@ -357,15 +356,40 @@ def load(path: str | Path) -> Run:
             f"path={str(path)!r} is not a complete run folder: {SUMMARY_FILE} lists {missing}, "
             "which are not there (moved, deleted, or the folder was copied in part)"
         )
-    try:
-        with xr.open_datatree(folder / DATA_FILE, engine="h5netcdf") as tree:
-            data = tree.load().copy()
-    except Exception as error:  # noqa: BLE001 - h5py and netCDF raise KeyError, OSError, ...
+    data, reason = _read_tree(folder / DATA_FILE)
+    if data is None:
         raise ValueError(
-            f"path={str(path)!r}: {DATA_FILE} could not be read ({error}); it is damaged or not "
+            f"path={str(path)!r}: {DATA_FILE} could not be read ({reason}); it is damaged or not "
             "a netCDF-4 file written by tumble: run the scenario again"
-        ) from None
+        )
     return Run(folder, summary, data)
+
+
+def _read_tree(file: Path) -> tuple[Any, str]:
+    """``(the file's DataTree, "")``, or ``(None, why not)`` for a damaged file.
+
+    h5netcdf leaves a half-opened file behind when the root group's header is damaged; its
+    ``close`` fails again when it is collected, and Python prints "Exception ignored in ..."
+    on stderr. It is collected here, with that report silenced, before the caller refuses
+    the file in one message.
+    """
+    import gc
+    import sys
+
+    import xarray as xr
+
+    hook = sys.unraisablehook
+    sys.unraisablehook = lambda unraisable: None
+    try:
+        try:
+            with xr.open_datatree(file, engine="h5netcdf") as tree:
+                return tree.load().copy(), ""
+        except Exception as error:  # noqa: BLE001 - h5py and netCDF raise KeyError, OSError, ...
+            reason = str(error)
+        gc.collect()  # the half-opened file, now that the traceback holding it is gone
+        return None, reason
+    finally:
+        sys.unraisablehook = hook
 
 
 def _read_summary(folder: Path) -> dict:

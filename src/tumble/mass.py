@@ -16,7 +16,7 @@ cylinder a, L      m a² / 2                    m (3 a² + L²) / 12
 hex prism a, L     5 m a² / 12                 m (5 a² / 24 + L² / 12)
 torus R, r         m (R² + 3 r² / 4)           m (R² / 2 + 5 r² / 8)
 sphere a           2 m a² / 5                  2 m a² / 5
-box (a, b, c)      I_x = m (b² + c²) / 12, and cyclically
+box (a, b, c)      I_x = m (b² + c²) / 12      and cyclically: I_y, I_z
 =================  ==========================  ==================================
 
 The hexagonal prism (circumradius ``a`` = side) follows from six equilateral triangles:
@@ -26,6 +26,9 @@ plane, so half of that about any in-plane axis.
 
 from __future__ import annotations
 
+import math
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -35,7 +38,7 @@ from tumble import _checks
 from tumble.so3 import validate_rotation
 
 SYMMETRY_RTOL = 1e-9
-"""Allowed |I - Iᵀ| relative to max |I| before an inertia is refused as not symmetric."""
+"""Allowed ‖I − Iᵀ‖ relative to max ‖I‖ before an inertia is refused as not symmetric."""
 TRIANGLE_RTOL = 1e-9
 """Allowed violation of I_a + I_b >= I_c, relative to the largest principal moment."""
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
@@ -250,6 +253,43 @@ def _mass(volume: float, density: float | None, mass: float | None) -> float:
     return _checks.positive("density", density, "kg/m³") * volume
 
 
+@contextmanager
+def _sized(
+    density: float | None, mass: float | None, **sizes: float
+) -> Iterator[Callable[..., None]]:
+    """Compute a primitive inside: ``check(m, *moments)`` refuses a mass or moment that is not
+    a finite float > 0 (an overflow, or an underflow to 0), and so is Python's OverflowError
+    (``a**3`` past 1.8e308), naming the argument furthest from 1 (a size, the density or the
+    mass) and the others."""
+    _mass(1.0, density, mass)  # refuses a bad density or mass first, by its own name
+    arguments = {name: (value, "m") for name, value in sizes.items()}
+    if mass is None:
+        arguments["density"] = (_checks.positive("density", density), "kg/m³")
+    else:
+        arguments["mass"] = (validate_mass(mass), "kg")
+
+    def refuse(what: str) -> ValueError:
+        name = max(arguments, key=lambda key: abs(math.log(arguments[key][0])))
+        others = [f"{key}={v!r} {unit}" for key, (v, unit) in arguments.items() if key != name]
+        given = ", ".join(others[:-1]) + " and " * (len(others) > 1) + others[-1]
+        allowed = "such that the mass and the moments of inertia are finite and > 0"
+        remedy = f"with {given} {what}; give the body in other units"
+        return _checks.fail(name, arguments[name][0], allowed, arguments[name][1], remedy)
+
+    def check(m: float, *moments: float) -> None:
+        if not 0 < m < math.inf:
+            raise refuse(f"the mass is {m:g} kg")
+        for moment in moments:
+            if not 0 < moment < math.inf:
+                raise refuse(f"a moment of inertia is {moment:g} kg m²")
+
+    try:
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            yield check
+    except OverflowError:
+        raise refuse("they overflow a float (past 1.8e308)") from None
+
+
 def _axisymmetric(
     mass: float, about_axis: float, about_diameter: float, axis: str | ArrayLike, center: ArrayLike
 ) -> MassProperties:
@@ -294,8 +334,11 @@ def cylinder(
     """
     a = _checks.positive("radius", radius, "m")
     L = _checks.positive("length", length, "m")
-    m = _mass(np.pi * a**2 * L, density, mass)
-    return _axisymmetric(m, m * a**2 / 2, m * (3 * a**2 + L**2) / 12, axis, center)
+    with _sized(density, mass, radius=a, length=L) as check:
+        m = _mass(np.pi * a**2 * L, density, mass)
+        about_axis, about_diameter = m * a**2 / 2, m * (3 * a**2 + L**2) / 12
+        check(m, about_axis, about_diameter)
+    return _axisymmetric(m, about_axis, about_diameter, axis, center)
 
 
 def hex_prism(
@@ -320,8 +363,11 @@ def hex_prism(
     """
     a = _checks.positive("circumradius", circumradius, "m")
     L = _checks.positive("length", length, "m")
-    m = _mass(1.5 * np.sqrt(3.0) * a**2 * L, density, mass)
-    return _axisymmetric(m, 5 * m * a**2 / 12, m * (5 * a**2 / 24 + L**2 / 12), axis, center)
+    with _sized(density, mass, circumradius=a, length=L) as check:
+        m = _mass(1.5 * np.sqrt(3.0) * a**2 * L, density, mass)
+        about_axis, about_diameter = 5 * m * a**2 / 12, m * (5 * a**2 / 24 + L**2 / 12)
+        check(m, about_axis, about_diameter)
+    return _axisymmetric(m, about_axis, about_diameter, axis, center)
 
 
 def validate_torus_radii(major_radius: float, minor_radius: float) -> tuple[float, float]:
@@ -360,8 +406,11 @@ def torus(
     array([3.238464, 3.238464, 5.860078])
     """
     R, r = validate_torus_radii(major_radius, minor_radius)
-    m = _mass(2 * np.pi**2 * R * r**2, density, mass)
-    return _axisymmetric(m, m * (R**2 + 0.75 * r**2), m * (R**2 / 2 + 5 * r**2 / 8), axis, center)
+    with _sized(density, mass, major_radius=R, minor_radius=r) as check:
+        m = _mass(2 * np.pi**2 * R * r**2, density, mass)
+        about_axis, about_diameter = m * (R**2 + 0.75 * r**2), m * (R**2 / 2 + 5 * r**2 / 8)
+        check(m, about_axis, about_diameter)
+    return _axisymmetric(m, about_axis, about_diameter, axis, center)
 
 
 def sphere(
@@ -379,8 +428,11 @@ def sphere(
     array([2., 2., 2.])
     """
     a = _checks.positive("radius", radius, "m")
-    m = _mass(4 * np.pi * a**3 / 3, density, mass)
-    return _axisymmetric(m, 0.4 * m * a**2, 0.4 * m * a**2, "z", center)
+    with _sized(density, mass, radius=a) as check:
+        m = _mass(4 * np.pi * a**3 / 3, density, mass)
+        moment = 0.4 * m * a**2
+        check(m, moment)
+    return _axisymmetric(m, moment, moment, "z", center)
 
 
 def box(
@@ -407,10 +459,13 @@ def box(
     array([13., 10.,  5.])
     """
     sides = _checks.array("extents", extents, shape=(3,), unit="m", positive=True)
-    m = _mass(float(np.prod(sides)), density, mass)
-    squares = sides**2
-    inertia = m * np.diag(squares.sum() - squares) / 12
-    body = MassProperties(m, np.zeros(3), inertia)
+    sizes = {f"extents[{i}]": float(side) for i, side in enumerate(sides)}
+    with _sized(density, mass, **sizes) as check:
+        m = _mass(float(np.prod(sides)), density, mass)
+        squares = sides**2
+        moments = m * (squares.sum() - squares) / 12
+        check(m, *moments)
+    body = MassProperties(m, np.zeros(3), np.diag(moments))
     if rotation is not None:
         body = body.rotated(rotation)
     return body.translated(center)

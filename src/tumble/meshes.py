@@ -10,7 +10,6 @@ in :mod:`tumble.mass`. trimesh is imported inside the functions, on first use.
 
 from __future__ import annotations
 
-import warnings
 from os import PathLike
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -18,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble import _checks
+from tumble import _checks, _mesh_files, _parts
 from tumble._atomic import atomic_write
 from tumble.mass import MassProperties, axis_vector, validate_point, validate_torus_radii
 from tumble.so3 import validate_rotation
@@ -32,6 +31,8 @@ LOAD_FORMATS = ("glb", "gltf", "obj", "off", "ply", "stl")
 """File extensions :func:`load` accepts (trimesh's triangle-mesh readers)."""
 SAVE_FORMATS = ("glb", "obj", "off", "ply", "stl")
 """File extensions :func:`save` writes (trimesh's mesh exporters)."""
+TEXT_FORMATS = ("gltf", "obj", "off")
+"""Formats that are text: a file of one whose bytes are not UTF-8 is refused as such."""
 
 
 def _placement(axis: str | ArrayLike, center: ArrayLike) -> np.ndarray:
@@ -211,13 +212,19 @@ def validate_solid(mesh: object, *, name: str = "mesh") -> trimesh.Trimesh:
 
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise _checks.fail(name, mesh, "a trimesh.Trimesh with faces or a mesh file path")
+    _check_finite(mesh, name, mesh, "a mesh with finite vertex coordinates")
     if not mesh.is_watertight:
-        raise _checks.fail(
-            name,
-            mesh,
-            "a closed (watertight) surface",
-            remedy="it is open; repair it, e.g. trimesh.repair.fill_holes(mesh)",
-        )
+        distinct = 1 + np.count_nonzero(np.diff(np.sort(mesh.faces, axis=1)), axis=1)
+        collapsed = np.flatnonzero(distinct < 3)
+        remedy = "it is open; repair it, e.g. trimesh.repair.fill_holes(mesh)"
+        if len(collapsed):
+            k = collapsed[0]
+            remedy = (
+                f"face {k} has {distinct[k]} distinct vertices ({len(collapsed)} faces "
+                "collapsed): trimesh's merge collapses vertices past about 9e10 m; build the "
+                "mesh with trimesh.Trimesh(vertices, faces, process=False), or in other units"
+            )
+        raise _checks.fail(name, mesh, "a closed (watertight) surface", remedy=remedy)
     if not mesh.is_winding_consistent:
         raise _checks.fail(
             name,
@@ -247,14 +254,15 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
     Returns
     -------
     trimesh.Trimesh
-        Duplicate vertices merged (trimesh's ``process=True``), so a closed STL is
-        watertight.
+        Vertices closer than 1e-8 m merged (as trimesh's ``process=True`` merges them, but
+        without its integer overflow past 9e10 m), so a closed STL is watertight.
 
     Raises
     ------
     ValueError
-        If the file does not exist, has an unknown extension, cannot be parsed, or holds no
-        triangles; the message names ``path`` and what is allowed.
+        If the file does not exist, has an unknown extension, cannot be parsed, holds no
+        triangles, or has a NaN or infinite coordinate; the message names ``path`` and what
+        is allowed.
 
     Examples
     --------
@@ -272,9 +280,11 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
         raise _checks.fail("path", str(path), "an existing mesh file", remedy="not found")
     file_type = _suffix(file, LOAD_FORMATS, "path")
     if file_type == "stl":
-        _check_stl(file, path)
+        _mesh_files.check_stl(file, path)
+    elif file_type in TEXT_FORMATS:
+        _mesh_files.check_text(file, path, file_type)
     try:
-        mesh = trimesh.load_mesh(file, file_type=file_type)
+        mesh = trimesh.load_mesh(file, file_type=file_type, process=False)
     except Exception as error:  # trimesh raises many types for a bad file
         cause = (
             "the reader needs an optional module that is missing"  # never an ImportError
@@ -291,29 +301,17 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
             "a mesh file with triangles",
             remedy=f"it has none (empty or not a {file_type} file)",
         )
-    return mesh
+    _check_finite(mesh, "path", str(path), "a mesh file with finite vertex coordinates")
+    return _mesh_files.merged(mesh)
 
 
-def _check_stl(file: Path, path) -> None:
-    """Refuse a file that is neither ASCII STL (text starting ``solid``) nor binary STL (an
-    80-byte header, a triangle count n, then 50 bytes per triangle: 84 + 50 n bytes)."""
-    size = file.stat().st_size
-    with open(file, "rb") as handle:
-        head = handle.read(84)
-    if head[:5].lower() == b"solid":
-        try:
-            head.decode("ascii")
-            return
-        except UnicodeDecodeError:
-            pass  # a binary file whose header starts with "solid": check it as binary
-    count = int.from_bytes(head[80:84], "little") if len(head) == 84 else -1
-    if count >= 0 and size == 84 + 50 * count:
-        return
-    raise _checks.fail(
-        "path", str(path), "an STL file",
-        remedy=f"it is neither ASCII STL (text starting 'solid') nor binary STL (84 + 50 n "
-        f"bytes for n triangles: this file has {size} bytes and its header says n = {count})",
-    )  # fmt: skip
+def _check_finite(mesh: trimesh.Trimesh, name: str, value: object, allowed: str) -> None:
+    """Refuse a mesh with a NaN or infinite coordinate, naming the first such vertex."""
+    bad = ~np.all(np.isfinite(mesh.vertices), axis=1)
+    if np.any(bad):
+        index = int(np.argmax(bad))
+        corner = ", ".join(f"{x:g}" for x in mesh.vertices[index])
+        raise _checks.fail(name, value, allowed, remedy=f"vertex {index} is [{corner}]")
 
 
 def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
@@ -355,9 +353,15 @@ def from_mesh(
 
     Uses trimesh's exact polyhedral integrals (Eberly, *Polyhedral Mass Properties*); the
     inertia is about the centre of mass, in the mesh's axes. The mesh must be closed
-    (watertight) and consistently wound. An inside-out mesh (negative signed volume) is
-    refused, unless ``fix_inside_out=True``: then its faces are flipped (on a copy) with a
-    ``UserWarning``.
+    (watertight) and consistently wound, enclose a nonzero volume, and its mass properties
+    must be finite floats.
+
+    A mesh may have several connected parts. Each is checked by its signed volume and its
+    nesting (``tumble._parts``): a part wound inward that lies inside another is a cavity,
+    and its volume is subtracted; a part wound outward inside a cavity is an island. A part
+    wound the other way (an inside-out part lying inside no other, or a cavity wound outward)
+    is refused, naming it, unless ``fix_inside_out=True``: then its faces are flipped (on a
+    copy) with a ``UserWarning``.
 
     Parameters
     ----------
@@ -380,21 +384,20 @@ def from_mesh(
     import trimesh
 
     rho = _checks.positive("density", density, "kg/m³")
-    given = mesh_or_path
+    given = str(mesh_or_path) if isinstance(mesh_or_path, PathLike) else mesh_or_path
     if isinstance(mesh_or_path, (str, PathLike)):
         mesh_or_path = load(mesh_or_path)
     mesh = validate_solid(mesh_or_path, name="mesh_or_path")
-    triangles = mesh.triangles
-    if mesh.volume < 0:
-        if not fix_inside_out:
-            raise _checks.fail(
-                "mesh_or_path",
-                given,
-                "outward-oriented",
-                remedy=f"it is inside-out (volume {mesh.volume:.6g} < 0); flip it with "
-                "mesh.invert(), or pass fix_inside_out=True",
-            )
-        warnings.warn("mesh is inside-out (negative volume); flipped", UserWarning, 2)
-        triangles = triangles[:, ::-1]
-    props = trimesh.triangles.mass_properties(triangles, density=rho)
-    return MassProperties(props.mass, props.center_mass, np.asarray(props.inertia))
+    triangles = _parts.oriented(
+        mesh.triangles, mesh.faces, name="mesh_or_path", value=given, fix_inside_out=fix_inside_out
+    )
+    with np.errstate(all="ignore"):  # an overflow is refused below, by name
+        props = trimesh.triangles.mass_properties(triangles, density=rho)
+    inertia = np.asarray(props.inertia)
+    if not (np.isfinite(props.mass) and np.all(np.isfinite(inertia))):
+        raise _checks.fail(
+            "mesh_or_path", given, "a mesh whose mass properties are finite floats",
+            remedy=f"with density={rho:g} kg/m³ and coordinates up to "
+            f"{np.max(np.abs(triangles)):.3g} m they overflow; give it in other units",
+        )  # fmt: skip
+    return MassProperties(props.mass, props.center_mass, inertia)

@@ -527,7 +527,7 @@ def random_rotation(
 
     Returns
     -------
-    ndarray, shape (*size, 3, 3)
+    ndarray, shape ``(*size, 3, 3)``
 
     Examples
     --------

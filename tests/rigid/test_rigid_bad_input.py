@@ -140,3 +140,17 @@ def test_an_adaptive_run_whose_load_turns_nan_says_so_not_minimum_step(method):
     assert run.status == -1
     assert run.message.startswith("the state became non-finite (nan or inf)"), run.message
     assert "a load" in run.message and run.t[-1] == pytest.approx(0.5)
+
+
+@pytest.mark.parametrize(
+    ("name", "options"),
+    [
+        ("omega0", {"omega0": [1e155, 0.0, 0.0]}),
+        ("L0", {"L0": [1e200, 0.0, 0.0]}),
+        ("v0", {"v0": [1e160, 0.0, 0.0]}),
+    ],
+)
+def test_an_initial_motion_whose_energy_overflows_is_refused_by_name(name, options):
+    # ½ ω·L overflowed and the run reported status 0 with energy inf from its first sample
+    with pytest.raises(ValueError, match=rf"^{name}=.* kinetic energy are finite floats"):
+        simulate(RigidBody(1.0, np.eye(3)), 1.0, h=0.1, **options)

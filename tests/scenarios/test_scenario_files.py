@@ -121,7 +121,7 @@ BAD_FILES = {
     "unknown top-level key": (
         T_HANDLE + "h = 0.01\n",
         "h is not a top-level key of a scenario file; allowed: description, options, "
-        "outputs, scenario (a scenario's options go under [options])",
+        "outputs, scenario, sweep (a scenario's options go under [options])",
     ),
     "unknown option": (
         T_HANDLE + "[options]\nspinz = []\n",
@@ -297,7 +297,7 @@ BAD_FILES = {
     "tolerance for a fixed step": (
         RIGID + "[options]\nrtol = 1e-6\n" + CYLINDER,
         "options: rtol=1e-06 is not allowed: must be None for the fixed-step method 'rkmk4'; "
-        "tolerances apply only to method='rkmk45'",
+        "tolerances apply only to the adaptive methods ('rkmk45', 'rkmk-dopri5')",
     ),
 }
 
@@ -435,3 +435,27 @@ def test_an_empty_list_is_refused_where_the_default_is_not_empty(name, option):
 def test_convergence_lists_only_fixed_step_methods():
     with pytest.raises(ValueError, match=r"must be one of euler, .*, rkmk8, split-axes, .*, dmv$"):
         check_options("convergence", {"methods": "rkmk45"})
+
+
+def test_a_primitive_whose_mass_overflows_is_refused_with_the_key(tmp_path):
+    # Issue 18, item 11: the TOML path raised the raw OverflowError of mass.sphere.
+    body = '[options.body]\nshape = "sphere"\nradius = 1e200\ndensity = 1e200\n'
+    path = write(tmp_path, RIGID + body)
+    with pytest.raises(
+        ValueError, match=r"options\.body: radius=1e\+200 is not allowed: .*finite"
+    ):
+        read(path)
+
+
+def test_a_mesh_with_a_separate_inside_out_part_is_refused_with_the_key(tmp_path):
+    # Issue 18, item 1: only the sign of the total volume was checked.
+    small = meshes.box([0.5, 0.5, 0.5], center=(1.5, 0.0, 0.0))
+    small.invert()
+    trimesh.util.concatenate([meshes.box([2.0, 2.0, 2.0]), small]).export(tmp_path / "two.stl")
+    path = write(tmp_path, RIGID + '[options.body]\nmesh = "two.stl"\ndensity = 1.0\n')
+    with pytest.raises(
+        ValueError,
+        match=r"options\.body\.mesh = 'two.stl': .*part 2 of 2 .* is inside-out .*flip that "
+        r"part and save the file again",
+    ):
+        read(path)

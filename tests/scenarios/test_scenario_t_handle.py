@@ -40,6 +40,15 @@ def test_measured_period_matches_the_closed_form(result, index):
     assert spin["period_measured"] == pytest.approx(spin["period_closed_form"], rel=1e-3)
 
 
+def test_flip_times_by_event_agree_with_the_exact_half_period(result):
+    flipping, *stable = result.summary["spins"]
+    # 11.8, 35.4, 59.1 s: FLIP_RTOL leaves ~1e-11 of the half period per flip (measured)
+    assert len(flipping["flip_times"]) == 3
+    assert max(abs(d) for d in flipping["flip_relative_differences"]) < 1e-8
+    assert flipping["half_period_exact"] == pytest.approx(flipping["period_closed_form"] / 2)
+    assert all(spin["flip_times"] is None for spin in stable)
+
+
 def test_closed_form_periods(result):
     periods = [spin["period_closed_form"] for spin in result.summary["spins"]]
     np.testing.assert_allclose(periods, [47.2614505, 16.6503765, 7.4083571], rtol=1e-7)

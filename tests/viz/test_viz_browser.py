@@ -1,4 +1,5 @@
-"""view.html in a real browser: headless Chromium (Debian's ``chromium``, ``chromium-driver``).
+"""view.html in a real browser: headless Chromium (Debian's ``chromium``, ``chromium-driver``;
+the ``browser`` fixture is in tests/conftest.py).
 
 ``make test`` installs both packages when they are missing. Without them these tests fail
 (they are not skipped): the viewer is only known to work once a browser has drawn it.
@@ -7,8 +8,6 @@ WebGL runs on SwiftShader (software); ``--enable-unsafe-swiftshader`` opts in to
 Chromium logs no deprecation warning for the automatic fallback.
 """
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -16,20 +15,6 @@ import tumble
 from tumble import meshes
 from tumble.viz.html import DIV_ID, html_viewer, viewer_figure
 
-CHROMIUM = Path("/usr/bin/chromium")
-CHROMEDRIVER = Path("/usr/bin/chromedriver")
-FLAGS = (
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--enable-unsafe-swiftshader",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--window-size=1280,1000",
-)
 WAIT_S = 20
 FRAMES = 20
 PLOT = f"document.getElementById('{DIV_ID}')"
@@ -54,35 +39,6 @@ def view(tmp_path_factory):
     path = tmp_path_factory.mktemp("view") / "view.html"
     html_viewer(run, meshes.t_handle(16), path, title="T-handle", frames=FRAMES)
     return path, viewer_figure(run, meshes.t_handle(16), title="T-handle", frames=FRAMES)
-
-
-@pytest.fixture(scope="module")
-def browser(tmp_path_factory):
-    """Headless Chromium through Debian's chromedriver; never downloads a driver."""
-    missing = [str(path) for path in (CHROMIUM, CHROMEDRIVER) if not path.exists()]
-    if missing:
-        pytest.fail(
-            f"{', '.join(missing)} not found: the browser test needs Debian's chromium and "
-            "chromium-driver; run `make test` (it installs them) or "
-            "`apt-get install chromium chromium-driver`",
-            pytrace=False,
-        )
-    from selenium import webdriver
-    from selenium.webdriver.chrome.service import Service
-
-    options = webdriver.ChromeOptions()
-    options.binary_location = str(CHROMIUM)
-    for flag in (*FLAGS, f"--user-data-dir={tmp_path_factory.mktemp('chromium-profile')}"):
-        options.add_argument(flag)
-    options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    service = Service(executable_path=str(CHROMEDRIVER))
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setenv("SE_OFFLINE", "true")  # selenium-manager must not look for a driver online
-        driver = webdriver.Chrome(service=service, options=options)
-    try:
-        yield driver
-    finally:
-        driver.quit()
 
 
 @pytest.fixture

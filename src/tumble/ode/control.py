@@ -33,6 +33,31 @@ def error_norm(
     return math.sqrt(float(scaled @ scaled) / scaled.size)
 
 
+def step_factor(
+    error_norm: float,
+    order: int,
+    safety: float,
+    min_factor: float,
+    max_factor: float,
+    after_rejection: bool,
+) -> float:
+    """How much the next step may grow or must shrink: the controller's one formula.
+
+    ``s ‖e‖^(−1/(q+1))`` bounded to ``[min_factor, max_factor]`` (to 1 after a rejection or
+    for a rejected step); a non-finite norm shrinks by ``min_factor``. Plain scalar code, so
+    that :class:`StepController` and the compiled adaptive loops of
+    :mod:`tumble.rigid.kernels` (which compile this very function) share it.
+    """
+    if not math.isfinite(error_norm):
+        return min_factor
+    if error_norm == 0.0:
+        factor = max_factor
+    else:
+        factor = safety * error_norm ** (-1.0 / (order + 1))
+    upper = 1.0 if (after_rejection or error_norm > 1.0) else max_factor
+    return min(upper, max(min_factor, factor))
+
+
 @dataclass(frozen=True)
 class StepController:
     """The classical (integral) step-size controller.
@@ -79,16 +104,9 @@ class StepController:
         h_next : float
             The step to try next: the following step if accepted, a retry if not.
         """
-        accepted = bool(error_norm <= 1.0)
-        if not np.isfinite(error_norm):
-            return False, h * self.min_factor
-        if error_norm == 0.0:
-            factor = self.max_factor
-        else:
-            factor = self.safety * error_norm ** (-1.0 / (order + 1))
-        upper = 1.0 if (after_rejection or not accepted) else self.max_factor
-        factor = min(upper, max(self.min_factor, factor))
-        return accepted, h * factor
+        factor = step_factor(float(error_norm), order, self.safety, self.min_factor,
+                             self.max_factor, after_rejection)  # fmt: skip
+        return bool(error_norm <= 1.0), h * factor
 
 
 def fixed_step_count(t0: float, t1: float, h: float) -> int:
@@ -117,8 +135,11 @@ def grid_time(t0: float, t1: float, h: float, k: int, n: int) -> float:
 
 
 def minimum_step(t: float) -> float:
-    """The smallest step that still moves ``t``: ten units in the last place."""
-    return 10.0 * math.ulp(t)
+    """The smallest step that still moves ``t``: ten units in the last place.
+
+    ``np.spacing(|t|)`` is ``math.ulp(t)``, in a form numba compiles too (the compiled
+    adaptive loops call this function)."""
+    return 10.0 * float(np.spacing(abs(t)))
 
 
 def initial_step(

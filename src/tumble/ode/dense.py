@@ -53,6 +53,8 @@ def step_coefficients(
     if tableau.dense is None:
         return hermite_coefficients(y0, y1, K[0], f1, h)
     if tableau.dense_A is None or tableau.dense_c is None:
+        if tableau.dense.shape[0] == tableau.stages + 1:  # the stages and f(t + h, y_{n+1})
+            return K.T @ tableau.dense[:-1] + np.outer(f1, tableau.dense[-1])
         return K.T @ tableau.dense
     if fun is None:
         raise ValueError(f"{tableau.name}'s dense output needs the right-hand side fun")

@@ -24,6 +24,11 @@ A stepper is an object with (see :class:`Stepper`, which gives the defaults):
     that events are located on). Called only after ``accept``.
 ``finite(state) -> bool``, ``scale(state) -> ndarray``
     Whether every number of a state is finite; the magnitudes the error is relative to.
+``norm(error, old, new, control) -> float``
+    The weighted size of a step's error estimate (by default Hairer's RMS norm,
+    :func:`~tumble.ode.control.error_norm`, over :meth:`~Stepper.scale`); a step is accepted
+    when it is at most 1. A stepper whose state has parts of different kinds (an attitude and
+    vectors) says here what the tolerances measure.
 ``failure(t_old, t_new) -> str``
     Why the step from ``t_old`` to ``t_new`` gave a state that is not finite (by default
     :func:`non_finite_message`; an implicit stepper names its unconverged solve).
@@ -32,14 +37,20 @@ A stepper is an object with (see :class:`Stepper`, which gives the defaults):
 ``march_block(state, grid, k0, k1, every, step0) -> Block`` (optional, ``blocks = True``)
     Steps ``k0 + 1 … k1`` of a fixed grid at once, compiled, recording every ``every``-th
     step: how the kernels keep their speed with no Python per step.
+``march_adaptive(state, t, t1, h, control, every, step0, max_steps) -> AdaptiveBlock``
+    (optional, ``adaptive_blocks = True``) Adaptive steps from ``t`` towards ``t1``, compiled,
+    with the same controller, norm and minimum step as :func:`march`; it returns at ``t1``,
+    at a failure, or when its record is full (then the driver calls it again).
 
 What :func:`march` guarantees
 -----------------------------
 * Steps land exactly on ``t1`` and on every jump time (a fixed grid restarts at each).
 * ``h`` is the step of a fixed-step run; for an adaptive run (``control`` given) the first
   step, then the :class:`~tumble.ode.control.StepController` proposes each next one from the
-  weighted norm (:func:`~tumble.ode.control.error_norm`); a rejected step is retried from the
-  accepted state. A step below :func:`~tumble.ode.control.minimum_step` ends the run.
+  weighted norm (:meth:`Stepper.norm`, weighed by :meth:`Control.weigh`); a rejected step is
+  retried from the accepted state. A step shortened to land on an end (``t1`` or a jump)
+  hands on the step it was planned as, not the proposal from its own, shorter, error. A step
+  below :func:`~tumble.ode.control.minimum_step` ends the run.
 * The record holds the initial state, every ``record_every``-th accepted step (counted over
   the whole run) and the final state; after a jump the state at the jump's time replaces the
   sample taken just before it.
@@ -49,6 +60,8 @@ What :func:`march` guarantees
 * Events ``g(t, state)`` are located by :class:`~tumble.ode.events.EventTracker` on the
   stepper's interpolant; a terminal event ends the run there with
   :attr:`Status.TERMINAL_EVENT`.
+* With ``t_eval``, the record holds the state at exactly those times (each step's
+  interpolant between the steps) instead of every ``record_every``-th step.
 * ``progress(t)`` is called as the run goes (per block, per jump segment, every
   :data:`PROGRESS_EVERY` Python steps).
 
@@ -209,6 +222,19 @@ class Stepper:
     def scale(self, state: Any) -> np.ndarray:
         return np.abs(state)
 
+    adaptive_blocks: bool = False
+    """Whether :meth:`march_adaptive` runs adaptive steps compiled."""
+
+    def norm(self, error: np.ndarray, old: Any, new: Any, control: Control) -> float:
+        """The weighted norm of ``error`` (Hairer's RMS over :meth:`scale`)."""
+        return error_norm(error, self.scale(old), self.scale(new), control.rtol, control.atol)
+
+    def march_adaptive(
+        self, state: Any, t: float, t1: float, h: float, control: Control, every: int,
+        step0: int, max_steps: float,
+    ) -> AdaptiveBlock:  # fmt: skip
+        raise NotImplementedError
+
     def failure(self, t_old: float, t_new: float) -> str:
         """Why the step from ``t_old`` to ``t_new`` gave a state that is not finite."""
         return non_finite_message(t_old, t_new)
@@ -222,6 +248,38 @@ class Stepper:
         raise NotImplementedError
 
 
+@dataclass
+class AdaptiveBlock:
+    """What a compiled adaptive block returns (:meth:`Stepper.march_adaptive`).
+
+    Attributes
+    ----------
+    t, records, state : as in :class:`Block`
+        The samples it recorded, and the state at ``t_end`` (the last accepted one).
+    t_end : float
+        Where it stopped.
+    h : float
+        The step the controller proposes next.
+    n_steps, n_rejected : int
+        Accepted and rejected steps in the block.
+    failure : str or None
+        None when it reached ``t1`` or filled its record; else why the run fails there
+        (``"non-finite"`` with ``t_failed`` the end of the failed step, ``"minimum-step"``
+        with ``finite`` whether its last error norm was finite).
+    """
+
+    t: np.ndarray
+    records: tuple
+    state: Any
+    t_end: float
+    h: float
+    n_steps: int
+    n_rejected: int
+    failure: str | None = None
+    t_failed: float = math.nan
+    finite: bool = True
+
+
 @dataclass(frozen=True)
 class Control:
     """Adaptive step control: tolerances and the controller (diffrax's split: the stepper
@@ -230,6 +288,15 @@ class Control:
     rtol: float
     atol: np.ndarray | float
     controller: StepController = field(default_factory=StepController)
+    horizon: float | None = None
+    """With the run's length ``T`` here, each step's error is held to its share ``h/T`` of
+    the tolerance (error per unit step, Hairer–Nørsett–Wanner I §II.4): the local errors then
+    add up to at most the tolerance over the run, so that rtol bounds the global error
+    (before the dynamics amplify it) instead of each step's. None: per step, as scipy."""
+
+    def weigh(self, norm: float, h: float) -> float:
+        """The step's norm as the controller judges it (per unit step with a horizon)."""
+        return norm if self.horizon is None else norm * (self.horizon / h)
 
 
 Jump = tuple[float, Callable[[Any], Any]]
@@ -284,6 +351,7 @@ class _Run:
         max_steps: float,
         dense: bool,
         progress: Callable[[float], None] | None,
+        t_eval: np.ndarray | None = None,
     ):
         self.stepper, self.t, self.state = stepper, t0, state
         self.every, self.max_steps, self.progress = record_every, max_steps, progress
@@ -294,7 +362,10 @@ class _Run:
         self.interpolants: list[Callable] | None = [] if dense else None
         self.times: list[np.ndarray] = []
         self.samples: list[tuple] = []
-        self.record()
+        self.t_eval, self.next_eval = t_eval, 0
+        if t_eval is None or t_eval[0] == t0:
+            self.record()
+            self.next_eval = 1
 
     def fail(self, message: str) -> None:
         self.status, self.message = Status.FAILED, message
@@ -308,7 +379,18 @@ class _Run:
         self.times.append(np.array([self.t]))
         self.samples.append(self.stepper.record(self.state))
 
-    def extend(self, block: Block) -> None:
+    def sample(self, t_new: float, new: Any, sol: Callable) -> None:
+        """Record the requested times in ``(t, t_new]`` from the step's interpolant."""
+        t_eval, k = self.t_eval, self.next_eval
+        assert t_eval is not None
+        while k < len(t_eval) and t_eval[k] <= t_new:
+            state = new if t_eval[k] == t_new else sol(float(t_eval[k]))
+            self.times.append(t_eval[k : k + 1].copy())
+            self.samples.append(self.stepper.record(state))
+            k += 1
+        self.next_eval = k
+
+    def extend(self, block: Block | AdaptiveBlock) -> None:
         if len(block.t):
             self.times.append(block.t)
             self.samples.append(block.records)
@@ -317,7 +399,7 @@ class _Run:
         """Take an accepted step; True when the run must stop (a terminal event)."""
         stepper = self.stepper
         stepper.accept(t_new, new)
-        if self.tracker is not None or self.interpolants is not None:
+        if self.tracker is not None or self.interpolants is not None or self.t_eval is not None:
             sol = stepper.interpolant(t_old, old, t_new, new)
             if self.tracker is not None:
                 t_stop = self.tracker.update(t_old, t_new, new, sol)
@@ -328,17 +410,24 @@ class _Run:
             if self.interpolants is not None and self.step_times is not None:
                 self.interpolants.append(sol)
                 self.step_times.append(t_new)
+            if self.t_eval is not None:
+                self.sample(t_new, new, sol)
         self.t, self.state = t_new, new
         self.n_steps += 1
-        if self.n_steps % self.every == 0:
+        if self.t_eval is None and self.n_steps % self.every == 0:
             self.record()
         if self.progress is not None and self.n_steps % PROGRESS_EVERY == 0:
             self.progress(t_new)
         return self.status == Status.TERMINAL_EVENT
 
     def outcome(self) -> Outcome:
-        if self.times[-1][-1] != self.t:
+        if self.t_eval is None and self.times[-1][-1] != self.t:
             self.record()
+        if not self.samples:  # t_eval asked for no time the run reached
+            empty = self.stepper.record(self.state)
+            axis = self.stepper.time_axis
+            self.times.append(np.empty(0))
+            self.samples.append(tuple(np.delete(a, 0, axis=axis) for a in empty))
         axis = self.stepper.time_axis
         records = tuple(
             np.concatenate(parts, axis=axis) for parts in zip(*self.samples, strict=True)
@@ -386,15 +475,17 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
             return False, h
         t_old, old = run.t, run.state
         h_min = minimum_step(t_old)
-        t_new = min(t_old + max(h, h_min), t1)
+        planned = max(h, h_min)
+        t_new = min(t_old + planned, t1)
         new, error = stepper.step(t_old, old, t_new - t_old)
         if error is None:
             raise TypeError(f"{type(stepper).__name__}.step returned no error estimate")
-        scale_old, scale_new = stepper.scale(old), stepper.scale(new)
-        norm = error_norm(error, scale_old, scale_new, control.rtol, control.atol)
+        norm = control.weigh(stepper.norm(error, old, new, control), t_new - t_old)
         accepted, h = control.controller.propose(
             t_new - t_old, norm, order, after_rejection=rejected
         )
+        if accepted and t_new == t1 < t_old + planned:
+            h = planned  # shortened to land on t1: its (round-off-level) norm does not count
         rejected = not accepted
         if not accepted:
             run.n_rejected += 1
@@ -407,6 +498,30 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
             return False, h
         if run.accept(t_old, old, t_new, new):
             return False, h
+    return True, h
+
+
+def _adaptive_blocks(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, float]:
+    """:func:`_adaptive` in the stepper's compiled blocks; (going on, the next step)."""
+    while run.t < t1:
+        block = run.stepper.march_adaptive(
+            run.state, run.t, t1, h, control, run.every, run.n_steps, run.max_steps - run.n_steps
+        )
+        run.extend(block)
+        run.n_steps += block.n_steps
+        run.n_rejected += block.n_rejected
+        run.t, run.state, h = block.t_end, block.state, block.h
+        if block.failure == "non-finite":
+            run.fail(run.stepper.failure(run.t, block.t_failed))
+            return False, h
+        if block.failure == "minimum-step":
+            run.fail(_minimum_step_message(run.t, minimum_step(run.t), block.finite))
+            return False, h
+        if run.n_steps >= run.max_steps and run.t < t1:
+            run.fail(f"max_steps={run.max_steps} reached at t={run.t!r}; increase `max_steps`")
+            return False, h
+        if run.progress is not None:
+            run.progress(run.t)
     return True, h
 
 
@@ -515,6 +630,7 @@ def march(
     max_steps: int | None = None,
     dense_output: bool = False,
     progress: Callable[[float], None] | None = None,
+    t_eval: np.ndarray | None = None,
 ) -> Outcome:
     """March ``stepper`` from ``state`` at ``t_span[0]`` to ``t_span[1]``.
 
@@ -542,6 +658,9 @@ def march(
         Keep every step's interpolant.
     progress : callable, optional
         ``progress(t)``, called as the run advances.
+    t_eval : ndarray, shape (k,), optional
+        Record the state at these times only (sorted, within ``t_span``; checked by the
+        caller), from each step's interpolant.
 
     Returns
     -------
@@ -564,14 +683,20 @@ def march(
         raise TypeError("march needs h: the fixed step, or an adaptive run's first step")
     step = float(h)
     limit = math.inf if max_steps is None else max_steps
-    run = _Run(stepper, t0, state, list(events), record_every, limit, dense_output, progress)
-    if control is None:
+    run = _Run(stepper, t0, state, list(events), record_every, limit, dense_output, progress,
+               t_eval)  # fmt: skip
+    if control is None and t_eval is None:
         check_record_size(t1 - t0, step, record_every, limit, run.samples[0], len(jumps))
-    compiled = stepper.blocks and control is None and not events and not dense_output
+    plain = not events and not dense_output and t_eval is None
+    compiled = stepper.blocks and control is None and plain
+    compiled_adaptive = stepper.adaptive_blocks and control is not None and plain
     going = True
     for end, applied in _segments(t0, t1, jumps):
         if run.t < end:
-            if control is not None:
+            if compiled_adaptive:
+                assert control is not None
+                going, step = _adaptive_blocks(run, end, step, control)
+            elif control is not None:
                 going, step = _adaptive(run, end, step, control)
             elif compiled:
                 going = _blocks(run, end, step)
@@ -581,7 +706,7 @@ def march(
             break
         for apply in applied:
             run.state = apply(run.state)
-        if applied:
+        if applied and (t_eval is None or run.t in t_eval):
             run.record()
         if progress is not None:
             progress(run.t)

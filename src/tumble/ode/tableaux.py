@@ -63,9 +63,11 @@ class ButcherTableau:
         Order of the embedded solution.
     fsal : bool
         First same as last: the last stage is ``f(t + h, y_{n+1})`` (its row of ``A`` is ``b``).
-    dense : array_like, shape (s, q) or (s + 1 + m, q), optional
+    dense : array_like, shape (s, q), (s + 1, q) or (s + 1 + m, q), optional
         The method's own continuous extension: ``y(t + θh) = y + h Σ_i k_i Σ_j P_ij θ^(j+1)``.
-        Without it, dense output is the cubic Hermite interpolant.
+        With ``s + 1`` rows the last stage is ``k_{s+1} = f(t + h, y_{n+1})``, which the next
+        step needs anyway (Fehlberg's pair). Without it, dense output is the cubic Hermite
+        interpolant.
     dense_c, dense_A : array_like, shapes (m,) and (m, s + 1 + m), optional
         Extra stages that only the continuous extension uses, computed after an accepted step
         when dense output is asked for. The stages are extended as
@@ -139,6 +141,8 @@ class ButcherTableau:
         rows = s if m == 0 and self.dense_A is None else s + 1 + m
         if self.dense_order is None:
             raise ValueError(f"{self.name}: a continuous extension must declare dense_order")
+        if m == 0 and self.dense_A is None and dense.shape[0] == s + 1:
+            rows = s + 1  # the stages and f(t + h, y_{n+1})
         if dense.shape[0] != rows:
             raise ValueError(f"{self.name}: dense must have {rows} rows, one per stage")
         if self.dense_A is not None and (
@@ -236,11 +240,27 @@ FEHLBERG45 = ButcherTableau(
     order=5,
     b_hat=[25 / 216, 0, 1408 / 2565, 2197 / 4104, -1 / 5, 0],
     order_hat=4,
+    # A fourth-order continuous extension from the six stages and k_7 = f(t + h, y_{n+1}):
+    # the order-4 conditions Σ b_i(θ) Φ_i(τ) = θ^|τ|/γ(τ) of the eight trees up to order 4
+    # (Hairer, Nørsett & Wanner, §II.6, Theorem 6.1) as identities in θ, plus b(1) = b and
+    # C¹ continuity (y' = f at θ = 0 and 1), leave one free coefficient: the θ⁴ term of k_6,
+    # set to 0. Solved exactly (rational arithmetic); tests/ode measures its order.
+    dense=[
+        [1, -71 / 30, 298 / 135, -13 / 18],
+        [0, 0, 0, 0],
+        [0, 1664 / 475, -3328 / 675, 1664 / 855],
+        [0, -15379 / 3135, 17576 / 1485, -2197 / 342],
+        [0, 54 / 25, -126 / 25, 27 / 10],
+        [0, 6 / 55, -4 / 55, 0],
+        [0, 3 / 2, -4, 5 / 2],
+    ],
+    dense_order=4,
     reference=(
         "Fehlberg, E. (1969). Low-order classical Runge-Kutta formulas with stepsize control "
         "and their application to some heat transfer problems. NASA TR R-315. The fifth-order "
         "solution is propagated (local extrapolation, as GSL's rkf45 and every modern pair do); "
-        "the fourth-order one only measures the error."
+        "the fourth-order one only measures the error. Its fourth-order, C¹ dense output is "
+        "derived here (the comment above the coefficients)."
     ),
 )
 

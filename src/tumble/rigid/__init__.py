@@ -7,11 +7,13 @@
 :class:`Gravity` …         loads: :class:`Force`, :class:`Torque`, :class:`MagneticDipole`,
                            :class:`Impulse`
 :data:`METHODS`            every method by name (the table: :mod:`tumble.rigid.methods`)
+:func:`flip_event`         an event at each flip of an intermediate-axis spin
 =========================  ===================================================================
 """
 
 from tumble.rigid.batch import BatchTrajectory, simulate_batch
 from tumble.rigid.body import RigidBody
+from tumble.rigid.events import flip_event
 from tumble.rigid.forces import Force, Gravity, Impulse, MagneticDipole, State, Torque
 from tumble.rigid.methods import METHODS, Method
 from tumble.rigid.simulation import simulate
@@ -29,6 +31,7 @@ __all__ = [
     "State",
     "Torque",
     "Trajectory",
+    "flip_event",
     "simulate",
     "simulate_batch",
 ]

@@ -26,6 +26,7 @@ field, and its numba field.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -81,6 +82,10 @@ class Chart:
     field : callable
         ``field(dynamics, correct, R_n) -> f(t, z)``; ``correct`` is False only for the
         uncorrected Lie stages of ``seed-rk4``.
+    first_same_as_last : callable, optional
+        ``(K, z_new) -> f`` at the new state in its own chart from the last stage ``K[-1]``
+        (``f(t + h, z_new)`` in the old chart) of a FSAL tableau; None where the chart
+        cannot reuse it.
     """
 
     name: str
@@ -91,6 +96,7 @@ class Chart:
     advance: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
     read: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
     field: Callable[[Dynamics, bool, np.ndarray], Field]
+    first_same_as_last: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
 
 
 def _identity(attitude: np.ndarray) -> np.ndarray:
@@ -125,6 +131,60 @@ def _lie_field(dynamics: Dynamics, correct: bool, Rn: np.ndarray) -> Field:
         return np.concatenate([udot, dynamics.rates(t, R, z[3:])])
 
     return f
+
+
+def error_norm(error, size, Y_old, Y_new, rtol, atol):
+    """The weighted size of a step's error estimate in a chart: what rtol and atol measure.
+
+    The state has four parts, each measured in its own units, and the norm is the largest of
+    their root-mean-square norms, so that parts that carry no error (x and p of a free body,
+    L without torque: their estimates are exactly zero) cannot dilute the others:
+
+    .. math::
+
+        \\|e\\| = \\max\\Bigl(\\mathrm{rms}_{i < n_a} \\frac{e_i}{r},\\;
+        \\max_{g \\in \\{x, p, L\\}} \\mathrm{rms}_{i \\in g}
+        \\frac{e_i}{a_i + r \\max(|y_i|, |y^{new}_i|)}\\Bigr)
+
+    * the first ``size`` numbers are the attitude's chart coordinates: for the ``lie`` chart
+      the increment ``u`` in radians, measured against ``rtol`` alone (a rotation's natural
+      size is one radian, so ``rtol = 1e-8`` asks each step's rotation to be right to 1e-8
+      rad); no ``atol`` applies to them, so it can never swamp ``rtol`` there;
+    * ``x`` (m), ``p`` (kg m/s) and ``L`` (kg m²/s) against ``atol + rtol·|y|``, Hairer's
+      mixed test, with ``atol`` of shape (9,).
+
+    Plain scalar code: the Python steppers call it and the compiled adaptive loops of
+    :mod:`tumble.rigid.kernels` compile this same function. A NaN anywhere gives NaN (the step
+    is rejected); an error of exactly zero counts as zero even where the scale is zero.
+    """
+    acc = 0.0
+    for i in range(size):
+        acc += (error[i] / rtol) ** 2
+    norm = math.sqrt(acc / size)
+    if norm != norm:  # NaN: the step is rejected
+        return norm
+    for group in range(3):
+        acc = 0.0
+        for c in range(3):
+            j = 3 * group + c
+            e = error[size + j]
+            if e != 0.0:
+                scale = atol[j] + rtol * max(abs(Y_old[j]), abs(Y_new[j]))
+                acc += (e / scale) ** 2
+        part = math.sqrt(acc / 3.0)
+        if part != part:
+            return part
+        norm = max(norm, part)
+    return norm
+
+
+def _lie_first_same_as_last(K: np.ndarray, z_new: np.ndarray) -> np.ndarray:
+    """The next step's first stage from this step's last (FSAL, Dormand–Prince).
+
+    ``K[-1]`` is ``(u̇, ẏ)`` at ``z_new`` in this step's chart, ``u̇ = dexp⁻¹_{−u}(ω)``; the
+    next chart starts at ``u = 0``, where ``u̇ = ω = dexp_{−u}(K[-1]_u)``. The vector part
+    is the same."""
+    return np.concatenate([so3.dexp(-z_new[:3]) @ K[-1, :3], K[-1, 3:]])
 
 
 def _frames(shape: tuple[int, ...]) -> np.ndarray:
@@ -174,6 +234,7 @@ LIE = Chart(
     advance=lambda z, Rn: (Rn @ so3.exp(z[:3]), z[3:].copy()),
     read=lambda z, Rn: (Rn.copy(), z[..., 3:].copy()),
     field=_lie_field,
+    first_same_as_last=_lie_first_same_as_last,
 )
 
 CHARTS: dict[str, Chart] = {chart.name: chart for chart in (MATRIX, QUAT, LIE)}

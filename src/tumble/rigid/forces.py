@@ -35,12 +35,20 @@ class State(NamedTuple):
         Linear momentum (kg m/s, world).
     L : ndarray, shape (3,)
         Angular momentum about the centre of mass (kg m²/s, world).
+    omega : ndarray, shape (3,), optional
+        Body-frame angular velocity ``I⁻¹ Rᵀ L`` (rad/s): given to events and
+        ``Trajectory.sol``, None for loads.
+    q : ndarray, shape (4,), optional
+        The attitude as a unit quaternion ``[w, x, y, z]``: given to events and
+        ``Trajectory.sol``, None for loads.
     """
 
     x: np.ndarray
     R: np.ndarray
     p: np.ndarray
     L: np.ndarray
+    omega: np.ndarray | None = None
+    q: np.ndarray | None = None
 
 
 Vector = Any

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from tumble import _checks, so3
@@ -22,8 +24,9 @@ def check_times(t0: float, t_end: float) -> tuple[float, float]:
     return t0, float(t_end)
 
 
-def check_steps(method: Method, h, rtol, atol) -> tuple[float | None, float, float]:
-    """The step for fixed-step methods, the tolerances for the adaptive one."""
+def check_steps(method: Method, h, rtol, atol) -> tuple[float | None, float, np.ndarray | None]:
+    """The step for fixed-step methods, the tolerances for the adaptive ones (``atol`` None
+    when not given: :func:`tolerances` derives it from the body)."""
     if h is not None:
         h = _checks.positive("h", h, "s")
     if not method.adaptive:
@@ -33,7 +36,7 @@ def check_steps(method: Method, h, rtol, atol) -> tuple[float | None, float, flo
                 None,
                 f"a step > 0 for the fixed-step method {method.name!r}",
                 "s",
-                "or use method='rkmk45' with rtol",
+                f"or an adaptive method ({adaptive_names()}) with rtol",
             )
         if rtol is not None or atol is not None:
             name, value = ("rtol", rtol) if rtol is not None else ("atol", atol)
@@ -41,13 +44,68 @@ def check_steps(method: Method, h, rtol, atol) -> tuple[float | None, float, flo
                 name,
                 value,
                 f"None for the fixed-step method {method.name!r}",
-                remedy="tolerances apply only to method='rkmk45'; "
+                remedy=f"tolerances apply only to the adaptive methods ({adaptive_names()}); "
                 f"{method.name!r} takes a fixed step h",
             )
-        return h, 0.0, 0.0
-    rtol = _checks.positive("rtol", 1e-6 if rtol is None else rtol)
-    atol = _checks.non_negative("atol", 1e-9 if atol is None else atol)
-    return h, rtol, atol
+        return h, 0.0, None
+    rtol = _checks.positive("rtol", DEFAULT_RTOL if rtol is None else rtol)
+    if rtol < MIN_RTOL:
+        raise _checks.fail("rtol", rtol, f">= {MIN_RTOL:.3g} (100 machine epsilons)",
+                           remedy="double precision cannot resolve less")  # fmt: skip
+    if atol is None:
+        return h, rtol, None
+    checked = _checks.array("atol", atol)
+    if checked.shape not in ((), (9,)) or np.any(checked < 0):
+        raise _checks.fail(
+            "atol", atol, ">= 0 and finite: a scalar, or shape (9,) for (x, p, L)",
+            "m, kg m/s, kg m²/s",
+            remedy="atol applies to x, p and L; the attitude is measured against rtol alone",
+        )  # fmt: skip
+    return h, rtol, np.broadcast_to(checked, (9,)).copy()
+
+
+DEFAULT_RTOL = 1e-6
+"""``rtol`` of the adaptive methods when none is given."""
+
+MIN_RTOL = 100 * np.finfo(float).eps
+"""The smallest ``rtol`` accepted: below it round-off decides."""
+
+
+def adaptive_names() -> str:
+    """The adaptive methods, for messages."""
+    from tumble.rigid.methods import METHODS
+
+    return ", ".join(repr(name) for name, m in METHODS.items() if m.adaptive)
+
+
+def sizes(body: RigidBody, Y: np.ndarray, span: float) -> np.ndarray:
+    """Characteristic sizes of ``(x, p, L)``, shape (9,): each part's initial size, and at
+    least one radius of gyration ``ℓ = √(tr I / m)`` for x, ``m ℓ / T`` for p and ``m ℓ² / T``
+    for L (a gyration radius, or a radian, over the run's length ``T``)."""
+    m = body.mass
+    ell = float(np.sqrt(np.trace(body.inertia) / m))
+    floors = (ell, m * ell / span, m * ell * ell / span)
+    parts = [max(float(np.abs(Y[3 * g : 3 * g + 3]).max()), floors[g]) for g in range(3)]
+    return np.repeat(parts, 3)
+
+
+def tolerances(body: RigidBody, Y: np.ndarray, span: float, rtol: float, atol) -> np.ndarray:
+    """``atol`` for ``(x, p, L)``, shape (9,): by default ``rtol`` times their characteristic
+    sizes (:func:`sizes`), so that a tighter ``rtol`` tightens every part. A given ``atol``
+    larger than that for every part makes ``rtol`` meaningless for them: a UserWarning says so.
+    """
+    scale = sizes(body, Y, span)
+    if atol is None:
+        return rtol * scale
+    if np.all(atol > rtol * scale):
+        warnings.warn(
+            f"atol={atol.max():.3g} exceeds rtol={rtol:.3g} times the sizes of x, p and L "
+            f"({scale[0]:.3g} m, {scale[3]:.3g} kg m/s, {scale[6]:.3g} kg m²/s): atol, not rtol, "
+            "sets their accuracy; leave atol unset to scale it with rtol",
+            UserWarning,
+            stacklevel=3,
+        )
+    return atol
 
 
 def initial_attitude(R0, q0) -> np.ndarray:
@@ -91,4 +149,17 @@ def initial_state(body: RigidBody, x0, v0, R0, q0, omega0, L0):
     else:
         L = R @ (body.inertia @ _vector(omega0, "omega0", "rad/s"))
     x, v = _vector(x0, "x0", "m"), _vector(v0, "v0", "m/s")
-    return R, np.concatenate([x, body.mass * v, L])
+    Y = np.concatenate([x, body.mass * v, L])
+    with np.errstate(over="ignore", invalid="ignore"):
+        m = R.T @ L
+        rotation = 0.5 * m @ (body.inertia_inverse @ m)
+        translation = 0.5 * body.mass * (v @ v)
+    if not np.all(np.isfinite(Y)) or not np.isfinite(rotation + translation):
+        name, value = ("L0", L0) if L0 is not None else ("omega0", omega0)
+        if not np.isfinite(translation) or not np.all(np.isfinite(Y[3:6])):
+            name, value = "v0", v0
+        raise _checks.fail(
+            name, value, "such that the momenta and the kinetic energy are finite floats",
+            remedy="they overflow (past 1.8e308): give the motion in other units",
+        )  # fmt: skip
+    return R, Y

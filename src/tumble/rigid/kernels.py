@@ -30,6 +30,9 @@ from typing import Any, NamedTuple
 import numpy as np
 from numba import njit, prange
 
+from tumble.ode import control
+from tumble.rigid import charts
+
 NON_FINITE, UNCONVERGED = 0, 1
 """Why a loop stopped at a step: its state was not finite, or an implicit flow's Newton
 iteration did not converge (``split`` loops)."""
@@ -167,6 +170,28 @@ def _lie_advance(z, znew, Rn):
     z[0] = z[1] = z[2] = 0.0
     for q in range(3, z.shape[0]):
         z[q] = znew[q]
+
+
+@njit(**_INLINE)
+def _lie_first_same_as_last(K, s, znew):
+    """``K[0] ← (dexp_{−u}(K[s−1]_u), K[s−1]_y)``: the next step's first stage, at ``u = 0``
+    in the new chart, from this step's last (as :func:`tumble.rigid.charts`' reference);
+    ``dexp_{−u} v = v − b u×v + c u×(u×v)`` with ``c = (1 − sin θ/θ)/θ²`` (series when
+    small)."""
+    u0, u1, u2 = znew[0], znew[1], znew[2]
+    x = u0 * u0 + u1 * u1 + u2 * u2
+    a, b = _exp_coefficients(x)
+    c = -(_S1 + x * (_S2 + x * (_S3 + x * (_S4 + x * _S5)))) if x < _SERIES2 else (1.0 - a) / x
+    K[0, 0], K[0, 1], K[0, 2] = _rotate(-b, c, u0, u1, u2, K[s - 1, 0], K[s - 1, 1], K[s - 1, 2])
+    for q in range(3, K.shape[1]):
+        K[0, q] = K[s - 1, q]
+    return True
+
+
+@njit(**_INLINE)
+def _no_first_same_as_last(K, s, znew):
+    """Charts that do not reuse the last stage (their loops recompute the first)."""
+    return False
 
 
 @njit(**_JIT)
@@ -352,6 +377,82 @@ def _batch(problem, grid, Z, RN, every, records, counts, failed, causes):
                                                body_records)  # fmt: skip
 
 
+def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, fsal, z, Rn, every, step0,
+                   max_steps, records):  # fmt: skip
+    """Adaptive steps from ``t`` towards ``t1`` for one chart: the driver's adaptive loop,
+    compiled (:func:`tumble.ode.driver.march` with a ``Control``).
+
+    Each try is the step of :func:`_loop` plus the embedded error estimate
+    ``h Σ e_i k_i``; its norm is :func:`tumble.rigid.charts.error_norm` and the next step
+    comes from :func:`tumble.ode.control.step_factor` (both compiled from those very
+    functions), tries start from the accepted state, and a step below
+    :func:`tumble.ode.control.minimum_step` ends the run, as in the driver. ``control`` is
+    ``(safety, min_factor, max_factor, order, horizon)`` (``horizon`` 0: none; see
+    :class:`tumble.ode.driver.Control`). With ``fsal`` (a FSAL tableau) an accepted step's
+    last stage becomes the next one's first through the chart's ``FIRST_SAME_AS_LAST``
+    (:attr:`tumble.rigid.charts.Chart.first_same_as_last`); a call starts with a fresh one.
+    Returns at ``t1``, when ``records`` is full
+    or after ``max_steps`` accepted steps:
+    ``(recorded, t, h_next, accepted, rejected, code, t_failed, norm_finite)`` with ``code`` 0
+    (going on), 1 (a non-finite accepted state; the step to ``t_failed``) or 2 (the minimum
+    step; ``norm_finite`` says whether the last norm was finite).
+    """
+    A, b = problem.A, problem.b
+    safety, min_factor, max_factor, order, horizon = control
+    s, nz = b.shape[0], z.shape[0]
+    size = nz - 9
+    K, zs, err, R = np.empty((s, nz)), np.empty(nz), np.empty(nz), np.empty((3, 3))
+    capacity = records.t.shape[0]
+    count, until_record = 0, every - step0 % every
+    accepted, rejected, after_rejection, have_first = 0, 0, False, False
+    while t < t1 and count < capacity and accepted < max_steps:
+        h_min = MINIMUM_STEP(t)  # noqa: F821
+        planned = max(h, h_min)
+        t_new = min(t + planned, t1)
+        hk = t_new - t
+        START(z, Rn)  # noqa: F821
+        for i in range(1 if have_first else 0, s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
+            for q in range(nz):
+                acc = 0.0
+                for j in range(i):
+                    acc += A[i, j] * K[j, q]
+                zs[q] = z[q] + hk * acc
+            FIELD(problem, zs, Rn, R, K, i)  # noqa: F821
+        for q in range(nz):  # z_new = z + h Σ b_i k_i, error h Σ e_i k_i
+            acc, acc_e = 0.0, 0.0
+            for i in range(s):
+                acc += b[i] * K[i, q]
+                acc_e += e[i] * K[i, q]
+            zs[q] = z[q] + hk * acc
+            err[q] = hk * acc_e
+        norm = NORM(err, size, z[size:], zs[size:], rtol, atol)  # noqa: F821
+        if horizon > 0.0:  # error per unit step (Control.horizon)
+            norm *= horizon / hk
+        h = hk * FACTOR(norm, order, safety, min_factor, max_factor, after_rejection)  # noqa: F821
+        after_rejection = not norm <= 1.0
+        if after_rejection:
+            rejected += 1
+            if h < h_min:
+                return count, t, h, accepted, rejected, 2, t_new, math.isfinite(norm)
+            continue
+        for q in range(nz):
+            if not math.isfinite(zs[q]):
+                return count, t, h, accepted, rejected, 1, t_new, True
+        if t_new == t1 and t + planned > t1:
+            h = planned  # shortened to land on t1 (as the driver)
+        ADVANCE(z, zs, Rn)  # noqa: F821
+        have_first = fsal and FIRST_SAME_AS_LAST(K, s, zs)  # noqa: F821
+        t = t_new
+        accepted += 1
+        until_record -= 1
+        if until_record == 0:
+            records.t[count] = t
+            RECORD(z, Rn, records.R[count], records.q[count], records.Y[count])  # noqa: F821
+            count += 1
+            until_record = every
+    return count, t, h, accepted, rejected, 0, t, True
+
+
 def _bind(template, name: str, **functions):
     """``template`` compiled with ``functions`` as its globals, cached under its own name.
 
@@ -366,24 +467,47 @@ def _bind(template, name: str, **functions):
 
 @dataclass(frozen=True)
 class CompiledChart:
-    """A chart's compiled loop for one body (:func:`_loop`) and for a batch (:func:`_batch`)."""
+    """A chart's compiled loop for one body (:func:`_loop`), for a batch (:func:`_batch`),
+    and its adaptive loop (:func:`_adaptive_loop`)."""
 
     loop: Callable[..., tuple[int, int, int]]
     batch: Callable[..., None]
+    adaptive: Callable[..., tuple] | None = None
 
 
-def _for_chart(name: str, field, advance, record, start=_no_start) -> CompiledChart:
-    loop = njit(**_JIT)(
-        _bind(_loop, f"_loop_{name}", FIELD=field, ADVANCE=advance, RECORD=record, START=start)
-    )
+# The step controller, the minimum step and the error norm are the Python reference's own
+# functions, compiled here: the adaptive loop and the driver cannot drift apart.
+_STEP_FACTOR = njit(**_INLINE)(control.step_factor)
+_MINIMUM_STEP = njit(**_INLINE)(control.minimum_step)
+_ERROR_NORM = njit(**_INLINE)(charts.error_norm)
+
+
+def _for_chart(
+    name: str, field, advance, record, start=_no_start, fsal=_no_first_same_as_last
+) -> CompiledChart:
+    chart = dict(FIELD=field, ADVANCE=advance, RECORD=record, START=start)
+    loop = njit(**_JIT)(_bind(_loop, f"_loop_{name}", **chart))
     batch = njit(parallel=True, **_JIT)(_bind(_batch, f"_batch_{name}", LOOP=loop))
-    return CompiledChart(loop, batch)
+    adaptive = njit(**_JIT)(
+        _bind(
+            _adaptive_loop,
+            f"_adaptive_{name}",
+            NORM=_ERROR_NORM,
+            FACTOR=_STEP_FACTOR,
+            MINIMUM_STEP=_MINIMUM_STEP,
+            FIRST_SAME_AS_LAST=fsal,
+            **chart,
+        )
+    )
+    return CompiledChart(loop, batch, adaptive)
 
 
 COMPILED: dict[str, CompiledChart] = {
     "matrix": _for_chart("matrix", _matrix_field, _matrix_advance, _matrix_record),
     "quat": _for_chart("quat", _quat_field, _quat_advance, _quat_record, _quat_start),
-    "lie": _for_chart("lie", _lie_field, _lie_advance, _lie_record),
+    "lie": _for_chart(
+        "lie", _lie_field, _lie_advance, _lie_record, fsal=_lie_first_same_as_last
+    ),  # fmt: skip
 }
 """Each chart of :data:`tumble.rigid.charts.CHARTS`, compiled."""
 

@@ -18,6 +18,7 @@ name                    family    tableau     what it is
 ``rkmk8``               lie       DOP853      RKMK with the 12 stages and order-8 weights of
                                               Dormand–Prince's DOP853: order 8
 ``rkmk45``              lie       Fehlberg    adaptive RKMK with Fehlberg's 4(5) pair
+``rkmk-dopri5``         lie       DOPRI5      adaptive RKMK with Dormand–Prince's 5(4) pair
 ======================  ========  ==========  =================================================
 
 The geometric methods (family ``split``) are splittings, not tableaux: each step is
@@ -56,7 +57,14 @@ import math
 from dataclasses import dataclass
 
 from tumble import _checks
-from tumble.ode.tableaux import DORMAND_PRINCE8, EULER, FEHLBERG45, RK4, ButcherTableau
+from tumble.ode.tableaux import (
+    DORMAND_PRINCE8,
+    DORMAND_PRINCE54,
+    EULER,
+    FEHLBERG45,
+    RK4,
+    ButcherTableau,
+)
 
 _CUBE_ROOT_2 = 2.0 ** (1.0 / 3.0)
 YOSHIDA4 = (
@@ -165,6 +173,7 @@ METHODS: dict[str, Method] = {
         Method("rkmk4", "lie", RK4),
         Method("rkmk8", "lie", DORMAND_PRINCE8),
         Method("rkmk45", "lie", FEHLBERG45),
+        Method("rkmk-dopri5", "lie", DORMAND_PRINCE54),
         Method("split-axes", "split", flow="axes", order_override=2),
         Method("split-axes4", "split", flow="axes", weights=YOSHIDA4, order_override=4),
         Method("midpoint-lp", "split", flow="midpoint", order_override=2),

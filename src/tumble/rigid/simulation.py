@@ -33,7 +33,7 @@ from tumble.rigid.steppers import (
     RigidStepper,
     SplitStepper,
 )
-from tumble.rigid.trajectory import Trajectory
+from tumble.rigid.trajectory import Solution, Trajectory
 
 if TYPE_CHECKING:
     from tumble.rigid.kernels import Problem
@@ -129,6 +129,8 @@ def simulate(
     record_every: int = 1,
     compiled: bool | None = None,
     pivot: ArrayLike | None = None,
+    t_eval: ArrayLike | None = None,
+    dense_output: bool = False,
 ) -> Trajectory:
     """Simulate a rigid body from ``t0`` to ``t_end``.
 
@@ -152,9 +154,19 @@ def simulate(
         A name in :data:`tumble.rigid.METHODS` (default ``"rkmk4"``); the table of
         methods, their charts, tableaux and orders is in :mod:`tumble.rigid.methods`.
     h : float
-        Step (s): required for the fixed-step methods; the first step for ``rkmk45``.
-    rtol, atol : float, optional
-        Tolerances of ``rkmk45`` (default 1e-6, 1e-9); refused for fixed-step methods.
+        Step (s): required for the fixed-step methods; the first step for the adaptive ones
+        (``rkmk45``, ``rkmk-dopri5``; chosen from ω and rtol when omitted).
+    rtol : float, optional
+        Relative tolerance of the adaptive methods (default 1e-6, at least 2.2e-14); refused
+        for fixed-step methods. Each step's rotation is kept right to ``rtol`` radians (the
+        attitude's error is measured in radians, against ``rtol`` alone), and x, p, L to
+        ``atol + rtol |y|`` (:func:`tumble.rigid.charts.error_norm`). The global error
+        falls with rtol down to round-off (docs/rigid-body.md: the table against scipy).
+    atol : float or array_like, shape (9,), optional
+        Absolute tolerance of x (m), p (kg m/s) and L (kg m²/s); it never applies to the
+        attitude. Default: ``rtol`` times each part's characteristic size
+        (:func:`tumble.rigid.initial.sizes`), so that it scales with rtol. A UserWarning
+        says when a given atol is so large that rtol no longer matters for any part.
     t0 : float
         Start time (s).
     x0, v0 : array_like, shape (3,), optional
@@ -171,14 +183,26 @@ def simulate(
         impulse's time, which must lie within the run).
     events : sequence of callables
         ``g(t, state) -> float`` with ``terminal``/``direction`` as in :func:`tumble.solve`;
-        ``state`` is a :class:`~tumble.rigid.forces.State`.
+        ``state`` is a :class:`~tumble.rigid.forces.State` with ``x``, ``R``, ``p``, ``L``,
+        ``omega`` (body frame) and ``q``. Crossings are located by root finding on each
+        step's interpolant (as ``t_eval``); an event that is zero at ``t0`` does not fire
+        there. :func:`tumble.rigid.flip_event` is the flip of an intermediate-axis spin.
     progress : bool
         Show a progress bar (rich) for long runs.
     record_every : int
         Keep every k-th step (and the last), to bound memory on long runs.
     compiled : bool, optional
-        Force (True) or forbid (False) the numba kernels; by default they run whenever the
-        method has a fixed step, every load is a constant and there are no events.
+        Force (True) or forbid (False) the numba kernels; by default they run whenever every
+        load is a constant and there are no events, ``t_eval`` or dense output (fixed-step
+        methods, and the adaptive ``lie`` methods).
+    t_eval : array_like, shape (k,), optional
+        Record the state at these times only (increasing, within ``[t0, t_end]``), from each
+        step's interpolant: for the ``lie`` methods ``R(t) = R_n exp(û(θ))`` with the
+        tableau's continuous extension (order 4 for ``rkmk45`` and ``rkmk-dopri5``), a
+        rotation to round-off. Runs in Python (no compiled kernel).
+    dense_output : bool
+        Keep every step's interpolant: ``Trajectory.sol(t)`` gives the state at any ``t`` of
+        the run. Runs in Python (no compiled kernel).
     pivot : array_like, shape (3,), optional
         A point of the body held fixed in space (body coordinates from the centre of mass, m):
         the heavy top. The body turns about it with its inertia there (parallel axis) under
@@ -208,14 +232,17 @@ def simulate(
     (11, True)
     """
     if pivot is not None:
+        if dense_output is not False:
+            raise _checks.fail("dense_output", dense_output, "False with a pivot",
+                               remedy="use t_eval to sample the run")  # fmt: skip
         return _about_pivot(
             body, t_end, pivot, method=method, h=h, rtol=rtol, atol=atol, t0=t0, x0=x0, v0=v0,
             R0=R0, q0=q0, omega0=omega0, L0=L0, forces=forces, events=events,
-            progress=progress, record_every=record_every, compiled=compiled,
+            progress=progress, record_every=record_every, compiled=compiled, t_eval=t_eval,
         )  # fmt: skip
     spec = get_method(method)
     t0, t_end = initial.check_times(t0, t_end)
-    h, rtol, atol = initial.check_steps(spec, h, rtol, atol)
+    h, rtol, given_atol = initial.check_steps(spec, h, rtol, atol)
     R, Y = initial.initial_state(body, x0, v0, R0, q0, omega0, L0)
     record_every = _checks.count("record_every", record_every)
     progress = _checks.flag("progress", progress)
@@ -223,19 +250,26 @@ def simulate(
     check_free(spec, loads)
     _check_impulse_times(forces, t0, t_end)
     events = _checks.callables("events", events, remedy="g(t, state) with state a State")
+    dense_output = _checks.flag("dense_output", dense_output)
+    times = None if t_eval is None else _checks.sample_times("t_eval", t_eval, t0, t_end)
+    tolerance = (
+        initial.tolerances(body, Y, t_end - t0, rtol, given_atol) if spec.adaptive else None
+    )
     kernel_loads = compiled_loads(loads, body.mass)
-    use_kernel = not spec.adaptive and kernel_loads is not None and not events
+    plain = not events and times is None and not dense_output
+    use_kernel = kernel_loads is not None and plain and (not spec.adaptive or spec.family == "lie")
     if compiled and not use_kernel:
         raise _checks.fail(
             "compiled", compiled, "False or None here",
-            remedy="the compiled kernels need a fixed-step method, constant loads and no events",
+            remedy="the compiled kernels need constant loads and no events, t_eval or dense "
+            "output (and a fixed-step or a lie method)",
         )  # fmt: skip
     use_kernel = use_kernel if compiled is None else bool(compiled)
     stepper = stepper_for(spec, body, loads, kernel_loads if use_kernel else None)
     settings = {
         "h": h,
         "rtol": rtol or None,
-        "atol": atol or None,
+        "atol": None if tolerance is None else tolerance.tolist(),
         "record_every": record_every,
         "compiled": use_kernel,
     }
@@ -243,7 +277,8 @@ def simulate(
     jumps = _jumps(stepper, impulses, t0, t_end)
     control = None
     if spec.adaptive:
-        control = Control(rtol, atol)
+        assert tolerance is not None
+        control = Control(rtol, tolerance, horizon=t_end - t0)
         if h is None:
             first = [apply for time, apply in jumps if time == t0]
             Y_first = first[0](state)[1] if first else Y
@@ -264,10 +299,15 @@ def simulate(
             jumps=jumps,
             record_every=record_every,
             progress=(lambda t: update(completed=t - t0)) if progress else None,
+            t_eval=times,
+            dense_output=dense_output,
         )
     if not out.status.success:
         log.warning("simulate stopped early: %s", out.message)
     R_samples, Y_samples, q_samples = out.records
+    sol = None
+    if out.step_times is not None and out.interpolants is not None:
+        sol = Solution(stepper, out.step_times, out.interpolants)
     with np.errstate(over="ignore", invalid="ignore"):
         V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
     return Trajectory(
@@ -286,6 +326,7 @@ def simulate(
         t_events=[np.array(ts, dtype=float) for ts in out.t_events],
         q_raw=q_samples if spec.family == "quat" else None,
         potential_energy=V,
+        sol=sol,
     )
 
 

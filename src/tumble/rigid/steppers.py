@@ -21,11 +21,13 @@ from collections.abc import Callable
 
 import numpy as np
 
+from tumble import so3
 from tumble._progress import announce_compilation
-from tumble.ode.driver import Block, Grid, Stepper, non_finite_message
+from tumble.ode.dense import StepInterpolant, step_coefficients
+from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Stepper, non_finite_message
 from tumble.ode.stepper import rk_step
 from tumble.rigid import geometric
-from tumble.rigid.charts import CHARTS, Dynamics
+from tumble.rigid.charts import CHARTS, Dynamics, error_norm
 from tumble.rigid.forces import State
 from tumble.rigid.methods import Method
 
@@ -37,6 +39,7 @@ class BodyStepper(Stepper):
     """What every rigid-body stepper shares: the attitude as R, users' events, impulses."""
 
     _quat = False
+    dynamics: Dynamics
 
     def matrix(self, attitude: np.ndarray) -> np.ndarray:
         """R for the carried attitude."""
@@ -48,9 +51,13 @@ class BodyStepper(Stepper):
         return np.array(self.matrix(attitude))[None], Y[None], q
 
     def public(self, state: RigidState) -> State:
-        """The state as users' loads and events see it: ``State(x, R, p, L)``."""
+        """The state as users' events and ``Trajectory.sol`` see it: ``State(x, R, p, L,
+        omega, q)``."""
         attitude, Y = state
-        return State(Y[:3], self.matrix(attitude), Y[3:6], Y[6:])
+        R = self.matrix(attitude)
+        q = attitude / np.linalg.norm(attitude) if self._quat else so3.quat_from_matrix(R)
+        omega = self.dynamics.omega(R, Y[6:])
+        return State(Y[:3], R, Y[3:6], Y[6:], omega, q)
 
     def event(self, event: Callable) -> Callable:
         """A user's ``g(t, State)`` as the driver's ``g(t, state)``."""
@@ -84,8 +91,10 @@ class RigidStepper(BodyStepper):
         self.chart = CHARTS[method.family]
         self.adaptive = method.adaptive
         self.error_order = method.tableau.error_order
-        self._chart_scale = np.ones(self.chart.size)  # chart errors measured against 1
         self._quat = self.chart.name == "quat"
+        self._last: tuple = ()  # the last step's field, z, base point, stages and z_new
+        self._fsal = method.tableau.fsal and self.chart.first_same_as_last is not None
+        self._first: tuple = (None, None)  # (accepted state, its first stage) with FSAL
 
     def start(self, state: tuple[np.ndarray, np.ndarray]) -> RigidState:
         """The stepped state for ``(R, Y)``: the attitude matrix and ``Y = (x, p, L)``."""
@@ -101,11 +110,45 @@ class RigidStepper(BodyStepper):
         z, Rn = chart.pack(*state)
         f = chart.field(self.dynamics, self.method.dexpinv, Rn)
         K = np.empty((tableau.stages, z.size))
-        z_new, error = rk_step(f, t, z, f(t, z), h, tableau, K)
+        first = self._first[1] if self._first[0] is state else f(t, z)
+        z_new, error = rk_step(f, t, z, first, h, tableau, K)
+        self._last = (f, z, Rn, K, z_new)
         return chart.advance(z_new, Rn), error
 
-    def scale(self, state: RigidState) -> np.ndarray:
-        return np.concatenate([self._chart_scale, np.abs(state[1])])
+    def accept(self, t: float, state: RigidState) -> None:
+        """With a FSAL tableau keep the accepted step's last stage as the next one's first
+        (:attr:`~tumble.rigid.charts.Chart.first_same_as_last`): one evaluation saved."""
+        if self._fsal:
+            _, _, _, K, z_new = self._last
+            assert self.chart.first_same_as_last is not None
+            self._first = (state, self.chart.first_same_as_last(K, z_new))
+
+    def norm(self, error: np.ndarray, old: RigidState, new: RigidState, control: Control) -> float:
+        """:func:`~tumble.rigid.charts.error_norm`: the attitude against rtol (radians in
+        the ``lie`` chart), x, p and L against ``atol + rtol |y|``."""
+        return error_norm(error, self.chart.size, old[1], new[1], control.rtol, control.atol)
+
+    def interpolant(
+        self, t_old: float, old: RigidState, t_new: float, new: RigidState
+    ) -> Callable[[float], RigidState]:
+        """The state between two accepted ones: the tableau's interpolant in the step's chart,
+        mapped back. For the ``lie`` chart ``R(t) = R_n exp(û(θ))`` with ``u(θ)`` the
+        tableau's continuous extension (order 4 for Fehlberg's and Dormand–Prince's pairs,
+        cubic Hermite otherwise), so every sample is a rotation to round-off; ``x``, ``p``,
+        ``L`` are interpolated the same way. Costs one field evaluation a step without a FSAL
+        tableau (``f`` at the step's end, in the step's chart)."""
+        f, z, Rn, K, z_new = self._last
+        tableau, chart, h = self.method.tableau, self.chart, t_new - t_old
+        assert tableau is not None
+        f1 = K[-1] if tableau.fsal else f(t_new, z_new)
+        poly = StepInterpolant(
+            t_old, h, z, step_coefficients(tableau, K, z, z_new, f1, h, f, t_old)
+        )
+
+        def sol(t: float) -> RigidState:
+            return new if t == t_new else chart.advance(poly(t), Rn)
+
+        return sol
 
 
 class SplitStepper(BodyStepper):
@@ -159,8 +202,13 @@ def unconverged_message(method: Method, t_old: float, t_new: float) -> str:
     )
 
 
+ADAPTIVE_BLOCK = 4096
+"""Samples a compiled adaptive block records before it returns to the driver."""
+
+
 class CompiledStepper(RigidStepper):
-    """:class:`RigidStepper` whose fixed grids march in the chart's compiled loop.
+    """:class:`RigidStepper` whose fixed grids march in the chart's compiled loop, and whose
+    adaptive steps (``rkmk45``, ``rkmk-dopri5``) run in the chart's compiled adaptive loop.
 
     ``problem`` is the kernels' :class:`~tumble.rigid.kernels.Problem` (constant loads).
     """
@@ -172,6 +220,38 @@ class CompiledStepper(RigidStepper):
 
         super().__init__(method, dynamics)
         self.problem, self.loop = problem, COMPILED[self.chart.name].loop
+        self.adaptive_loop = COMPILED[self.chart.name].adaptive
+        self.adaptive_blocks = method.adaptive and self.adaptive_loop is not None
+
+    def march_adaptive(
+        self, state: RigidState, t: float, t1: float, h: float, control: Control, every: int,
+        step0: int, max_steps: float,
+    ) -> AdaptiveBlock:  # fmt: skip
+        tableau, controller = self.method.tableau, control.controller
+        assert tableau is not None and tableau.e is not None and self.adaptive_loop is not None
+        records = _records(ADAPTIVE_BLOCK)
+        z, Rn = self.chart.pack(*state)
+        settings = (controller.safety, controller.min_factor, controller.max_factor,
+                    tableau.error_order, float(control.horizon or 0.0))  # fmt: skip
+        atol = np.broadcast_to(np.asarray(control.atol, dtype=float), (9,)).copy()
+        announce_compilation(self.adaptive_loop, f"the {self.chart.name} chart's adaptive loop")
+        count, t_end, h_next, accepted, rejected, code, t_failed, finite = self.adaptive_loop(
+            self.problem, tableau.e, t, t1, h, control.rtol, atol, settings, self._fsal, z, Rn,
+            every, step0, float(max_steps), records,
+        )  # fmt: skip
+        q = records.q[:count] if self._quat else np.empty((count, 0))
+        return AdaptiveBlock(
+            t=records.t[:count],
+            records=(records.R[:count], records.Y[:count], q),
+            state=self.chart.read(z, Rn),
+            t_end=t_end,
+            h=h_next,
+            n_steps=accepted,
+            n_rejected=rejected,
+            failure={0: None, 1: "non-finite", 2: "minimum-step"}[code],
+            t_failed=t_failed,
+            finite=finite,
+        )
 
     def march_block(
         self, state: RigidState, grid: Grid, k0: int, k1: int, every: int, step0: int

@@ -2,14 +2,58 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 
 from tumble import so3
 from tumble.ode.driver import Status
 from tumble.rigid.body import RigidBody
+from tumble.rigid.forces import State
+
+
+class Solution:
+    """The continuous solution of a run (``simulate(..., dense_output=True).sol``).
+
+    ``sol(t)`` is the :class:`~tumble.rigid.forces.State` at ``t`` (``x``, ``R``, ``p``,
+    ``L``, ``omega``, ``q``), from the interpolant of the step that holds ``t``: for the
+    ``lie`` methods ``R(t) = R_n exp(û(θ))``, a rotation to round-off. An array of ``k``
+    times gives each field with a leading axis of length ``k``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from tumble import RigidBody, simulate
+    >>> body = RigidBody(1.0, [2.0, 1.0, 2 / 3], allow_unphysical=True)
+    >>> run = simulate(body, 10.0, method="rkmk-dopri5", rtol=1e-10, omega0=(0.2, 1.0, 0.3),
+    ...                dense_output=True)
+    >>> R = run.sol([2.5, 7.25]).R
+    >>> R.shape, bool(np.abs(R[1].T @ R[1] - np.eye(3)).max() < 1e-13)
+    ((2, 3, 3), True)
+    """
+
+    def __init__(self, stepper: Any, ts: Sequence[float], interpolants: Sequence[Callable]):
+        self.stepper, self.ts = stepper, np.asarray(ts, dtype=float)
+        self.interpolants = list(interpolants)
+
+    def __call__(self, t: float | Sequence[float] | np.ndarray) -> State:
+        times = np.asarray(t, dtype=float)
+        if np.any(times < self.ts[0]) or np.any(times > self.ts[-1]):
+            raise ValueError(
+                f"t={t!r} is not allowed: must be within the run, [{self.ts[0]}, {self.ts[-1]}]"
+            )
+        index = np.clip(np.searchsorted(self.ts, times, side="right") - 1, 0,
+                        len(self.interpolants) - 1)  # fmt: skip
+        states = [
+            self.stepper.public(self.interpolants[int(i)](float(s)))
+            for i, s in zip(np.ravel(index), np.ravel(times), strict=True)
+        ]
+        if times.ndim == 0:
+            return states[0]
+        return State(*(np.stack(parts) for parts in zip(*states, strict=True)))
 
 
 @dataclass
@@ -47,6 +91,8 @@ class Trajectory:
     potential_energy : ndarray, shape (n,), optional
         ``V`` of the loads that derive from a potential (gravity, constant forces, magnetic
         dipoles), J; zeros without such loads (``None`` given: zeros).
+    sol : Solution, optional
+        The continuous solution, ``sol(t)``, with ``simulate(..., dense_output=True)``.
 
     Notes
     -----
@@ -74,6 +120,7 @@ class Trajectory:
     t_events: list = field(default_factory=list)
     q_raw: np.ndarray | None = None
     potential_energy: np.ndarray = None  # type: ignore[assignment]
+    sol: Solution | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.potential_energy is None:

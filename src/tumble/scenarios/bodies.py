@@ -49,7 +49,7 @@ from pydantic import (
     model_validator,
 )
 
-from tumble import mass, meshes
+from tumble import _parts, mass, meshes
 from tumble.mass import MassProperties
 from tumble.scenarios.schema import (
     Matrix3,
@@ -204,14 +204,12 @@ class MeshBody(Section):
             raise custom_error("file", "no such file (looked for {path})", path=str(path))
         try:
             surface = meshes.validate_solid(meshes.load(path), name="the mesh")
+            _parts.oriented(  # each part outward, each cavity inward
+                surface.triangles, surface.faces, name="the mesh", value=value,
+                fix_hint=" and save the file again",
+            )  # fmt: skip
         except ValueError as error:
             raise custom_error("mesh", "{reason}", reason=str(error)) from None
-        if surface.volume < 0:
-            raise custom_error(
-                "inside_out",
-                "the mesh is inside-out (negative volume); flip its faces (trimesh: "
-                "mesh.invert()) and save it again",
-            )
         return str(path)
 
     @model_validator(mode="after")
@@ -291,10 +289,13 @@ class Composite(Section):
         return "composite (" + " + ".join(part.label() for part in self.parts) + ")"
 
 
-Body = _union(
-    {"<primitive>": Primitive, "<mesh>": MeshBody, "<composite>": Composite},
-    "the body needs shape (a primitive), parts (a composite) or mesh (a mesh file)",
-)
+if TYPE_CHECKING:  # as Part above
+    Body = Cylinder | Box | Sphere | Torus | HexPrism | MeshBody | Composite
+else:
+    Body = _union(
+        {"<primitive>": Primitive, "<mesh>": MeshBody, "<composite>": Composite},
+        "the body needs shape (a primitive), parts (a composite) or mesh (a mesh file)",
+    )
 
 
 __all__ = [

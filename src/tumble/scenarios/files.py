@@ -1,6 +1,6 @@
 """Scenario files: TOML that names a scenario and its options, validated with pydantic.
 
-A file has one required key and three optional ones::
+A file has one required key and four optional ones::
 
     scenario = "t-handle"          # a name from `tumble list`
     description = "..."            # free text, shown nowhere but kept
@@ -8,6 +8,8 @@ A file has one required key and three optional ones::
     h = 0.01
     [outputs]                      # what `tumble run` writes
     animation = true
+    [sweep.grid]                   # what `tumble sweep` runs (docs/sweeps.md)
+    omega0.1 = "0.001:0.1:50"
 
 ``[options]`` holds exactly what :func:`tumble.scenarios.get(scenario).run(**options)
 <tumble.scenarios.get>` takes, so a file that sets every option to its default gives the same
@@ -44,7 +46,7 @@ from pathlib import Path
 from typing import Any, ClassVar
 
 from tumble.scenarios.option_models import METHOD_CHOICES, POSITIVE, options_model
-from tumble.scenarios.schema import Flag, Section, Text, short_repr, validate
+from tumble.scenarios.schema import Flag, PositiveInteger, Section, Text, short_repr, validate
 
 
 def check_options(
@@ -101,6 +103,18 @@ class Outputs(Section):
     """Write ``animation.gif`` and ``view.html`` (``--no-animation`` overrides)."""
 
 
+class Sweep(Section):
+    """``[sweep]``: what ``tumble sweep FILE`` runs when no ``--grid`` is given.
+
+    ``[sweep.grid]`` maps option paths to values (``omega0.1 = "0.001:0.1:50"`` or a list;
+    :mod:`tumble.sweeps.plan`); ``chunk`` is the members per task.
+    """
+
+    what: ClassVar[str] = "a key of [sweep]"
+    grid: dict[str, Any] = {}
+    chunk: PositiveInteger | None = None
+
+
 class _File(Section):
     what: ClassVar[str] = "a top-level key of a scenario file"
     hint: ClassVar[str] = " (a scenario's options go under [options])"
@@ -108,6 +122,7 @@ class _File(Section):
     description: Text = ""
     options: dict[str, Any] = {}
     outputs: Outputs = Outputs()
+    sweep: Sweep = Sweep()
 
 
 @dataclass(frozen=True)
@@ -126,6 +141,8 @@ class ScenarioFile:
         The file, absolute.
     description : str
         The file's free-text ``description``.
+    sweep : Sweep
+        ``[sweep]``: the grid ``tumble sweep`` runs by default.
     """
 
     scenario: str
@@ -133,6 +150,7 @@ class ScenarioFile:
     outputs: Outputs
     source: Path
     description: str = field(default="")
+    sweep: Sweep = field(default_factory=Sweep)
 
 
 def _load_toml(path: Path) -> dict[str, Any]:
@@ -191,6 +209,7 @@ def read(path: str | Path) -> ScenarioFile:
         outputs=top.outputs,
         source=path.resolve(),
         description=top.description,
+        sweep=top.sweep,
     )
 
 
@@ -200,6 +219,7 @@ __all__ = [
     "Outputs",
     "ScenarioFile",
     "Section",
+    "Sweep",
     "check_options",
     "options_model",
     "read",

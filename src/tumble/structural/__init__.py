@@ -13,10 +13,19 @@ Time stepping
     (``t``, ``x``, ``y``, ``energy``, ``tip_displacement``). The step matrix is factorised
     once, banded Cholesky or sparse LU by its band (:mod:`tumble.structural.factorization`),
     and the loop runs compiled (:mod:`tumble.structural.stepping`).
+Exact reference
+    :func:`exact_response` — the motion of a linear system by modal superposition
+    (:class:`ModalSolution`), at any time, with Rayleigh damping: the yardstick of every
+    scheme's error.
 Stability
     :func:`critical_dt` (a :class:`CriticalStep`: the step, ``ω_max`` and whether that mode
     is axial or bending), :func:`stability_sweep` (energy growth per dt),
     :func:`energy_scale`.
+Time-step analysis
+    :func:`amplification` — each scheme's amplification matrix on the oscillator against
+    ``Ω = ωΔt``: spectral radius, algorithmic damping, period elongation, critical Ω
+    (:class:`Amplification`); :func:`mode_table` — every mode of a system at one Δt
+    (:class:`ModeTable`).
 Elements
     :mod:`tumble.structural.elements` — element stiffness, consistent mass and internal
     forces as pure functions.
@@ -37,6 +46,8 @@ array([52.4971])
 """
 
 from tumble.structural import elements
+from tumble.structural.alpha import HHT, Bathe, GeneralizedAlpha
+from tumble.structural.amplification import Amplification, ModeTable, amplification, mode_table
 from tumble.structural.assembly import (
     SUPPORT_KINDS,
     IllConditionedWarning,
@@ -44,6 +55,7 @@ from tumble.structural.assembly import (
     cantilever,
     condition_estimate,
 )
+from tumble.structural.modal import ModalSolution, exact_response, modal_energies
 from tumble.structural.schemes import (
     EXPLICIT,
     IMPLICIT,
@@ -67,6 +79,10 @@ from tumble.structural.stability import (
 from tumble.structural.system import FrameElements, LinearSystem, RayleighDamping
 
 __all__ = [
+    "Amplification",
+    "ModeTable",
+    "amplification",
+    "mode_table",
     "EXPLICIT",
     "IMPLICIT",
     "MIDPOINT",
@@ -75,10 +91,14 @@ __all__ = [
     "SEED_SCHEMES",
     "SEMI_IMPLICIT",
     "SUPPORT_KINDS",
+    "Bathe",
     "CriticalStep",
     "FrameElements",
+    "GeneralizedAlpha",
+    "HHT",
     "IllConditionedWarning",
     "LinearSystem",
+    "ModalSolution",
     "Newmark",
     "RayleighDamping",
     "Response",
@@ -90,6 +110,8 @@ __all__ = [
     "critical_dt",
     "elements",
     "energy_scale",
+    "exact_response",
     "integrate",
+    "modal_energies",
     "stability_sweep",
 ]

@@ -40,6 +40,13 @@ narrow (every beam, and every frame numbered along its members or renumbered by 
 Cuthill–McKee), sparse LU otherwise (:mod:`tumble.structural.factorization`) — and with the
 banded factor runs the whole time loop compiled (:func:`tumble.structural.kernels.run_steps`).
 
+Three schemes with controllable numerical damping join them in :data:`SCHEMES`, written in
+the same increments with their own compiled loops (:mod:`tumble.structural.alpha`):
+``hht`` (:class:`~tumble.structural.alpha.HHT`), ``generalized-alpha``
+(:class:`~tumble.structural.alpha.GeneralizedAlpha`, by ρ∞) and ``bathe``
+(:class:`~tumble.structural.alpha.Bathe`, the ρ∞-Bathe composite). Every scheme declares its
+``order`` (the tests measure it against :func:`~tumble.structural.exact_response`).
+
 References
 ----------
 .. [1] Ł. Łaniewski-Wołłk, *Metody Numeryczne, Instrukcja 5: Równania ruchu* (seed 003).
@@ -62,7 +69,13 @@ from tumble import _checks
 from tumble._progress import progress_bar
 from tumble.ode.driver import Status, Stepper, march
 from tumble.structural import stepping
-from tumble.structural.factorization import MAX_BANDWIDTH, band_structure, banded_cholesky
+from tumble.structural.alpha import HHT, AlphaScheme, Bathe, GeneralizedAlpha
+from tumble.structural.factorization import (
+    MAX_BANDWIDTH,
+    BandedCholesky,
+    band_structure,
+    banded_cholesky,
+)
 from tumble.structural.stepping import Increments, State
 from tumble.structural.system import LinearSystem, RayleighDamping
 
@@ -85,6 +98,11 @@ class ThetaScheme:
     theta_x: float
     theta_y: float
     seed_name: str
+
+    @property
+    def order(self) -> int:
+        """Order of accuracy: 2 for θ_x = θ_y = ½ (midpoint), else 1."""
+        return 2 if self.theta_x == self.theta_y == 0.5 else 1
 
     def matrix(self, system: LinearSystem, C: sp.spmatrix | None, dt: float) -> sp.spmatrix:
         """The constant matrix ``M + θ_y Δt C + θ_x θ_y Δt² S``."""
@@ -129,6 +147,11 @@ class Newmark:
         _checks.non_negative("beta", self.beta)
         _checks.positive("gamma", self.gamma)
 
+    @property
+    def order(self) -> int:
+        """Order of accuracy: 2 for γ = ½, else 1 (Hughes 2000, §9.1)."""
+        return 2 if self.gamma == 0.5 else 1
+
     def matrix(self, system: LinearSystem, C: sp.spmatrix | None, dt: float) -> sp.spmatrix:
         """The constant matrix ``M + γ Δt C + β Δt² S``."""
         A = system.M + (self.beta * dt * dt) * system.S
@@ -151,16 +174,25 @@ SEMI_IMPLICIT = ThetaScheme("semi-implicit", 0.0, 1.0, "semi-implicit")
 IMPLICIT = ThetaScheme("implicit", 1.0, 1.0, "fully implicit")
 MIDPOINT = ThetaScheme("midpoint", 0.5, 0.5, "midpoint (quarter steps)")
 NEWMARK = Newmark()
+HHT_ALPHA = HHT()
+GENERALIZED_ALPHA = GeneralizedAlpha()
+BATHE = Bathe()
 
-SCHEMES: dict[str, ThetaScheme | Newmark] = {
-    s.name: s for s in (EXPLICIT, SEMI_IMPLICIT, IMPLICIT, MIDPOINT, NEWMARK)
-}
-"""The schemes by name; ``newmark`` has β = ¼, γ = ½ (pass :class:`Newmark` to change)."""
+Scheme = ThetaScheme | Newmark | AlphaScheme | Bathe
+
+SCHEMES: dict[str, Scheme] = {
+    s.name: s
+    for s in (EXPLICIT, SEMI_IMPLICIT, IMPLICIT, MIDPOINT, NEWMARK, HHT_ALPHA, GENERALIZED_ALPHA,
+              BATHE)
+}  # fmt: skip
+"""The schemes by name, with their default parameters: ``newmark`` β = ¼, γ = ½; ``hht``
+α = −0.05; ``generalized-alpha`` ρ∞ = 0.8; ``bathe`` ρ∞ = 0 (the original Bathe method).
+Pass :class:`Newmark`, :class:`~tumble.structural.alpha.HHT`,
+:class:`~tumble.structural.alpha.GeneralizedAlpha` or :class:`~tumble.structural.alpha.Bathe`
+to change them."""
 
 SEED_SCHEMES = ("explicit", "semi-implicit", "implicit", "midpoint")
 """The four schemes of seed 003, in its order."""
-
-Scheme = ThetaScheme | Newmark
 
 
 @dataclass(frozen=True, eq=False)
@@ -217,7 +249,7 @@ class Response:
 
 def resolve_scheme(scheme: str | Scheme) -> Scheme:
     """A scheme object from its name (one of :data:`SCHEMES`) or the object itself."""
-    if isinstance(scheme, ThetaScheme | Newmark):
+    if isinstance(scheme, ThetaScheme | Newmark | AlphaScheme | Bathe):
         return scheme
     return SCHEMES[_checks.choice("scheme", scheme, SCHEMES)]
 
@@ -249,9 +281,11 @@ def integrate(
     ----------
     system : LinearSystem
         From :func:`~tumble.structural.cantilever` or :func:`~tumble.structural.build_frame`.
-    scheme : str or ThetaScheme or Newmark
-        ``"explicit"``, ``"semi-implicit"``, ``"implicit"``, ``"midpoint"``, ``"newmark"``,
-        or e.g. ``Newmark(beta=0.3025, gamma=0.6)``.
+    scheme : str or scheme object
+        A name from :data:`SCHEMES` (``"explicit"``, ``"semi-implicit"``, ``"implicit"``,
+        ``"midpoint"``, ``"newmark"``, ``"hht"``, ``"generalized-alpha"``, ``"bathe"``), or
+        a scheme with its parameters, e.g. ``Newmark(beta=0.3025, gamma=0.6)``,
+        ``GeneralizedAlpha(rho_inf=0.5)`` (:mod:`tumble.structural.alpha`).
     dt : float
         Time step [s], > 0.
     n_steps, t_end : int or float
@@ -300,6 +334,8 @@ def integrate(
         max(1, BLOCK_WORK // system.n_dofs),
     )  # Ctrl-C is seen between blocks; fmt: skip
     stepper, solver = _choose_stepper(system, scheme, dt, C, compiled, block)
+    if isinstance(scheme, AlphaScheme | Bathe):
+        state = scheme.start(system, state, C, dt)
     start = stepper.start(state)
     with progress_bar(progress, n_steps, scheme.name) as update, _quiet_overflow():
 
@@ -329,12 +365,31 @@ def integrate(
 def _choose_stepper(
     system: LinearSystem, scheme: Scheme, dt: float, C, compiled: bool | None, block: int
 ) -> tuple[Stepper, str]:
-    """The compiled stepper with a banded Cholesky of the step matrix, or the reference
-    stepper with SuperLU; and the solver's name."""
-    A, k = scheme.matrix(system, C, dt), scheme.increments(dt)
-    structure = band_structure(A)
+    """The compiled stepper with banded Cholesky factors of the step matrices, or the
+    reference stepper with SuperLU; and the solver's name."""
+    if isinstance(scheme, AlphaScheme | Bathe):
+        matrices = scheme.matrices(system, C, dt)
+    else:
+        matrices = [scheme.matrix(system, C, dt)]
+    factors = _banded_factors(matrices, compiled)
+    if factors is None:
+        if isinstance(scheme, AlphaScheme | Bathe):
+            return scheme.reference(system, C, dt, matrices), "sparse-lu"
+        return stepping.ReferenceStepper(
+            system, scheme.increments(dt), matrices[0], C
+        ), "sparse-lu"
+    if isinstance(scheme, AlphaScheme | Bathe):
+        return scheme.compiled(system, C, dt, factors, block), "banded-cholesky"
+    stepper = stepping.CompiledStepper(system, scheme.increments(dt), factors[0], C, block)
+    return stepper, "banded-cholesky"
+
+
+def _banded_factors(matrices: list, compiled: bool | None) -> list[BandedCholesky] | None:
+    """Banded Cholesky factors of ``matrices``, all in one DOF order (the first's), or None
+    when the band is not narrow (or ``compiled=False``) and the caller should use SuperLU."""
+    structure = band_structure(matrices[0])
     if not (structure.narrow if compiled is None else compiled):
-        return stepping.ReferenceStepper(system, k, A, C), "sparse-lu"
+        return None
     if structure.bandwidth > MAX_BANDWIDTH:
         raise _checks.fail(
             "compiled",
@@ -344,12 +399,12 @@ def _choose_stepper(
             "leave compiled=None to use the sparse LU",
         )
     try:
-        factor = banded_cholesky(A, structure.order)
+        first = banded_cholesky(matrices[0], structure.order)
+        return [first] + [BandedCholesky.from_matrix(A, first.order) for A in matrices[1:]]
     except np.linalg.LinAlgError:  # κ(A) beyond 1/ε: a pivot came out <= 0
         if compiled:
             raise
-        return stepping.ReferenceStepper(system, k, A, C), "sparse-lu"
-    return stepping.CompiledStepper(system, k, factor, C, block), "banded-cholesky"
+        return None
 
 
 def _step_count(n_steps: int | None, t_end: float | None, dt: float) -> int:

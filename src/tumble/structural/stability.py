@@ -34,6 +34,7 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from tumble import _checks
+from tumble.structural.alpha import AlphaScheme, Bathe
 from tumble.structural.schemes import Newmark, Scheme, integrate, resolve_scheme
 from tumble.structural.system import DENSE_EIGEN_LIMIT, LinearSystem
 
@@ -99,15 +100,17 @@ def critical_dt(system: LinearSystem, scheme: str | Scheme) -> CriticalStep:
     ('5.593e-06 s', 'bending', inf)
     """
     scheme = resolve_scheme(scheme)
-    z_max = _critical_z(scheme)
+    z_max = critical_omega(scheme)
     if z_max == 0.0 or math.isinf(z_max):
         return CriticalStep(scheme.name, z_max)
     omega, shape = highest_mode(system)
     return CriticalStep(scheme.name, z_max / omega, omega, mode_kind(system, shape))
 
 
-def _critical_z(scheme: Scheme) -> float:
+def critical_omega(scheme: Scheme) -> float:
     """Largest stable ``ω Δt`` of a scheme (0: never stable; inf: always)."""
+    if isinstance(scheme, AlphaScheme | Bathe):  # refused unless unconditionally stable
+        return math.inf
     if isinstance(scheme, Newmark):
         beta, gamma = scheme.beta, scheme.gamma
         if gamma < 0.5:

@@ -29,7 +29,7 @@ Tests check that the two agree to round-off.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 import scipy.sparse as sp
@@ -86,6 +86,18 @@ class State:
         """The state at ``(x, y)``, with ``S x`` and ``S y`` summed element by element."""
         return cls(x, y, system.f - system.internal_forces(x), system.internal_forces(y))
 
+    def vectors(self) -> tuple[NDArray, ...]:
+        """Every vector of the state, in field order (a subclass may carry more)."""
+        return tuple(getattr(self, f.name) for f in fields(self))
+
+    def copy(self) -> State:
+        """A deep copy (every vector copied)."""
+        return type(self)(*(v.copy() for v in self.vectors()))
+
+    def permuted(self, order: NDArray) -> State:
+        """The state with every vector taken in ``order`` (contiguous copies)."""
+        return type(self)(*(np.ascontiguousarray(v[order]) for v in self.vectors()))
+
 
 Solve = Callable[[NDArray], NDArray]
 
@@ -133,7 +145,7 @@ class ReferenceStepper(Stepper):
         return state
 
     def step(self, t: float, state: State, h: float) -> tuple[State, None]:
-        new = State(state.x.copy(), state.y.copy(), state.q.copy(), state.g.copy())
+        new = state.copy()
         reference_step(new, self.k, self.system, self.solve, self.solve_mass, self.C)
         return new, None
 
@@ -158,28 +170,29 @@ class CompiledStepper(Stepper):
     blocks = True
 
     def __init__(self, system: LinearSystem, k: Increments, factor: BandedCholesky, C, block):
-        order = factor.order
+        mass = BandedCholesky.from_matrix(system.M, factor.order) if k.mass_solve else factor
+        self.prepare(system, (factor, mass), C, block)
+        self.coefficients = (k.dt, k.k_g, k.k_dy, k.k_sa, k.k_a)
+        self.work = tuple(np.zeros(self.order.size) for _ in range(4))
+
+    def prepare(self, system: LinearSystem, factors: tuple[BandedCholesky, ...], C, block) -> None:
+        """What every compiled loop reads, in the first factor's DOF order: the factors
+        (padded to one bandwidth, for which the loop is compiled), the element arrays, the
+        damping matrix as CSR; and the number of steps per block."""
+        order = factors[0].order
         self.order, self.inverse = order, np.empty_like(order)
         self.inverse[order] = np.arange(order.size)
-        mass = BandedCholesky.from_matrix(system.M, order) if k.mass_solve else factor
-        b = max(factor.bandwidth, mass.bandwidth)  # the loop is compiled for one bandwidth
-        self.factor, self.mass = (
-            _kernel_factor(_padded(factor, b)),
-            _kernel_factor(_padded(mass, b)),
-        )
+        b = max(factor.bandwidth for factor in factors)
+        self.factors = tuple(_kernel_factor(_padded(factor, b)) for factor in factors)
         dof_map, *element_arrays = system.elements.kernel_arrays
         permuted_map = np.where(dof_map >= 0, self.inverse[np.maximum(dof_map, 0)], -1)
         self.frame = (permuted_map.astype(np.int32), *element_arrays)
         self.damping = _csr_arrays(None if C is None else sp.csr_matrix(C)[order][:, order])
-        self.coefficients = (k.dt, k.k_g, k.k_dy, k.k_sa, k.k_a)
-        self.work = tuple(np.zeros(order.size) for _ in range(4))
         self.block_steps = block
 
     def start(self, state: State) -> State:
         """``state`` in the factor's DOF order."""
-        return State(
-            *(np.ascontiguousarray(v[self.order]) for v in (state.x, state.y, state.q, state.g))
-        )
+        return state.permuted(self.order)
 
     def record(self, state: State) -> tuple:
         return state.x[self.inverse][None], state.y[self.inverse][None]
@@ -187,8 +200,9 @@ class CompiledStepper(Stepper):
     def _run(self, state: State, k0: int, k1: int, steps: NDArray[np.int64], xs, ys):
         vectors = (state.x, state.y, state.q, state.g)
         announce_compilation(run_steps, "the structural time loop")
-        return run_steps(k0, k1, steps, 0, self.coefficients, vectors, self.frame, self.factor,
-                         self.mass, self.damping, self.work, xs, ys)  # fmt: skip
+        factor, mass = self.factors
+        return run_steps(k0, k1, steps, 0, self.coefficients, vectors, self.frame, factor, mass,
+                         self.damping, self.work, xs, ys)  # fmt: skip
 
     def march_block(
         self, state: State, grid: Grid, k0: int, k1: int, every: int, step0: int
@@ -197,7 +211,7 @@ class CompiledStepper(Stepper):
         steps = k[(step0 + k) % every == 0]
         n = self.order.size
         xs, ys = np.empty((steps.size + 1, n)), np.empty((steps.size + 1, n))
-        start = State(state.x.copy(), state.y.copy(), state.q.copy(), state.g.copy())
+        start = state.copy()
         steps_padded = np.append(steps, -1)  # the kernel reads one entry past its last record
         rows, failed = self._run(state, k0, k1, steps_padded, xs, ys)
         if failed >= 0:  # replay to the step before, from the block's start

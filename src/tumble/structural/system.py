@@ -13,6 +13,7 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -154,14 +155,58 @@ class LinearSystem:
         full[..., self.free] = x
         return full
 
+    @cached_property
+    def strain_factor(self) -> sp.csr_matrix:
+        """``G`` with ``S = Gᵀ G``, shape (n_rows, n_dofs): ``√D_e B_e`` element by element.
+
+        Row blocks are ``L_eᵀ B_e`` with ``D_e = L_e L_eᵀ`` (Cholesky of the element's
+        ``diag(EA/h, EI/h [[4, 2], [2, 4]])``) and ``B_e`` its natural deformations
+        (:func:`~tumble.structural.elements.deformation_matrices`); rows touching no free
+        DOF are dropped. ``‖G x‖² = xᵀ S x`` is a sum of squares of element deformations,
+        computed without the cancellation of ``xᵀ (S x)`` on fine meshes.
+        """
+        e = self.elements
+        B = elements.deformation_matrices(e.length, e.cos, e.sin)
+        D = elements.deformation_stiffness(e.length, e.EA, e.EI)
+        D[:, 0, 0] = np.maximum(D[:, 0, 0], 0.0)
+        root = np.zeros_like(D)  # D = root rootᵀ, lower triangular; a zero EA gives a zero row
+        root[:, 0, 0] = np.sqrt(D[:, 0, 0])
+        root[:, 1:, 1:] = np.linalg.cholesky(D[:, 1:, 1:])
+        blocks = np.einsum("eji,ejk->eik", root, B)  # rootᵀ B, shape (n_elements, 3, 6)
+        n_elements = blocks.shape[0]
+        rows = np.broadcast_to(np.arange(3 * n_elements).reshape(-1, 3, 1), blocks.shape)
+        columns = np.broadcast_to(e.dof_map[:, None, :], blocks.shape)
+        keep = (columns >= 0) & (blocks != 0)
+        G = sp.csr_matrix(
+            (blocks[keep], (rows[keep], columns[keep])), shape=(3 * n_elements, self.n_dofs)
+        )
+        return G[np.diff(G.indptr) > 0]
+
     def modes(self, k: int) -> tuple[NDArray, NDArray]:
         """The ``k`` lowest natural frequencies and mode shapes, ``S φ = ω² M φ``.
 
-        Solved as the inverse problem ``M φ = ω⁻² S φ``, whose largest eigenvalues carry
-        the lowest frequencies to full relative accuracy (the direct dense problem loses
-        ``ε κ(S)`` in ``ω₁``): densely with ``scipy.linalg.eigh`` up to
-        :data:`DENSE_EIGEN_LIMIT` DOFs, otherwise with ``scipy.sparse.linalg.eigsh`` in
-        shift-invert mode about σ = 0, using :func:`factorize` for ``S⁻¹``.
+        The stiffness enters only through its element factor ``S = Gᵀ G``
+        (:attr:`strain_factor`), never as the assembled ``S``, whose ``κ(S) ∝ N⁴`` costs the
+        lowest frequencies ``ε κ(S)`` of relative accuracy (measured: mode 1 of the 1 m
+        steel cantilever was 7.6e-6 off at 640 elements, where the discretisation error is
+        5e-14).
+
+        - Up to :data:`DENSE_EIGEN_LIMIT` DOFs (or ``k ≥ n − 1``), densely: with the Jacobi
+          scaling ``Δ = diag(M)^{-½}`` and ``Δ M Δ = L Lᵀ``, the frequencies are the singular
+          values of ``H = G Δ L⁻ᵀ`` and the shapes ``φ = Δ L⁻ᵀ v`` (its right singular
+          vectors): a singular value is found to ``ε σ_max``, so ``ω₁`` to
+          ``ε ω_max/ω₁`` relative, instead of ``ε (ω_max/ω₁)²``.
+        - Above, ARPACK (``eigsh``) in shift-invert mode about 0 for the subspace, with
+          ``S⁻¹`` applied through ``G`` (:meth:`_stiffness_solve`, error ``∝ √κ(S)``), then
+          a Rayleigh–Ritz step on it with ``Φᵀ S Φ = (G Φ)ᵀ (G Φ)``: the frequencies'
+          error is then the square of the subspace's.
+
+        Measured on that cantilever against the exact roots of ``cos βL cosh βL = −1``
+        (discretisation error included): mode 1 within 9e-13 at 320 elements, 1.5e-13 at
+        640, 3e-14 at 1280, 2.3e-13 at 2560, 8.6e-12 at 5000, 9.5e-11 at 10⁴ and 4.8e-9 at
+        2·10⁴ (before: 8.5e-7, 7.6e-6, 7.0e-6, 8.7e-6, 6.4e-8, 3.1e-6, 8.2e-4). Past about
+        3700 elements the builder warns (:class:`~tumble.structural.IllConditionedWarning`)
+        for the static and time-stepped results; the frequencies hold longer.
 
         Returns
         -------
@@ -175,17 +220,50 @@ class LinearSystem:
         if k > n:
             raise _checks.fail("k", k, f"an integer from 1 to n_dofs = {n}")
         if n <= DENSE_EIGEN_LIMIT or k >= n - 1:
-            inverse, shapes = scipy.linalg.eigh(
-                self.M.toarray(), self.S.toarray(), subset_by_index=(n - k, n - 1)
-            )
-            lam, shapes = 1.0 / inverse[::-1], shapes[:, ::-1]
-        else:
-            solve = spla.LinearOperator((n, n), matvec=factorize(self.S), dtype=float)
-            lam, shapes = spla.eigsh(self.S, k=k, M=self.M, sigma=0.0, OPinv=solve)
-            order = np.argsort(lam)
-            lam, shapes = lam[order], shapes[:, order]
-        shapes = shapes / np.sqrt(np.sum(shapes * (self.M @ shapes), axis=0))
-        return np.sqrt(lam), shapes
+            omega, shapes = self._dense_modes()
+            return omega[:k], shapes[:, :k]
+        solve = spla.LinearOperator((n, n), matvec=self._stiffness_solve(), dtype=float)
+        _, basis = spla.eigsh(self.S, k=k, M=self.M, sigma=0.0, OPinv=solve)
+        projected = self.strain_factor @ basis
+        lam, coefficients = scipy.linalg.eigh(projected.T @ projected, basis.T @ (self.M @ basis))
+        shapes = basis @ coefficients
+        shapes /= np.sqrt(np.sum(shapes * (self.M @ shapes), axis=0))
+        return np.sqrt(np.maximum(lam, 0.0)), shapes
+
+    def _stiffness_solve(self) -> Callable[[NDArray], NDArray]:
+        """``b ↦ S⁻¹ b`` from the factor ``G`` alone: the augmented system.
+
+        With ``Δ = diag(M)^{-½}``, ``G̃ = G Δ`` and ``a = max |G̃|``, the sparse LU of
+        ``[[a I, G̃], [G̃ᵀ, 0]]`` solves ``[[a I, G̃], [G̃ᵀ, 0]] (r, w) = (0, Δ b)``, and
+        ``S⁻¹ b = −a Δ w`` (Björck 1996, §2.5): its error grows with ``κ(G) = √κ(S)``
+        instead of ``κ(S)``.
+        """
+        G = self.strain_factor
+        rows = G.shape[0]
+        scale = 1.0 / np.sqrt(self.M.diagonal())
+        scaled = (G @ sp.diags(scale)).tocsr()
+        weight = float(abs(scaled).max())
+        augmented = sp.bmat([[weight * sp.identity(rows), scaled], [scaled.T, None]], "csc")
+        lu = spla.splu(augmented)
+
+        def solve(b: NDArray) -> NDArray:
+            out = lu.solve(np.concatenate([np.zeros(rows), scale * np.ravel(b)]))
+            return -weight * scale * out[rows:]
+
+        return solve
+
+    def _dense_modes(self) -> tuple[NDArray, NDArray]:
+        """All frequencies and M-orthonormal shapes from the SVD of ``G Δ L⁻ᵀ`` (see modes)."""
+        scale = 1.0 / np.sqrt(self.M.diagonal())
+        mass = self.M.toarray() * scale[:, None] * scale[None, :]
+        lower = np.linalg.cholesky(mass)
+        factor = self.strain_factor.toarray() * scale[None, :]
+        H = scipy.linalg.solve_triangular(lower, factor.T, lower=True).T
+        if H.shape[0] < self.n_dofs:  # fewer deformation rows than DOFs: a mechanism
+            H = np.vstack([H, np.zeros((self.n_dofs - H.shape[0], self.n_dofs))])
+        _, sigma, vt = scipy.linalg.svd(H, full_matrices=False)
+        shapes = scale[:, None] * scipy.linalg.solve_triangular(lower.T, vt[::-1].T, lower=False)
+        return sigma[::-1].copy(), shapes
 
     def natural_frequencies(self, k: int) -> NDArray:
         """The ``k`` lowest angular frequencies ``ω`` [rad/s]; see :meth:`modes`.

@@ -1,0 +1,261 @@
+"""What a time step does to one mode: the amplification matrix and what it tells.
+
+Applied to the single-DOF oscillator ``ẍ + 2ξω ẋ + ω² x = 0`` with ``Ω = ωΔt``, every
+scheme of :data:`~tumble.structural.SCHEMES` is a linear map of its state,
+``zⁿ⁺¹ = G(Ω, ξ) zⁿ`` (``z = (x, Δt y)``, plus ``Δt² a`` for the generalized-α family).
+:func:`amplification` builds ``G`` column by column by running the scheme's *own* NumPy
+reference step (:func:`tumble.structural.stepping.reference_step`,
+:func:`tumble.structural.alpha.alpha_step`, :func:`tumble.structural.alpha.bathe_step`)
+on a one-DOF system with ``M = 1``, ``S = Ω²``, ``C = 2ξΩ``, ``Δt = 1``; so what is
+analysed is what runs. From its eigenvalues (Hughes 2000, §9.2; Chung & Hulbert 1993):
+
+- the spectral radius ``ρ = max |λ|``: stable where ``ρ ≤ 1``;
+- the principal pair ``λ = A ± iB = exp(Ω̄(−ξ̄ ± i))``: the algorithmic damping ratio
+  ``ξ̄ = −ln(A² + B²)/(2Ω̄)`` and the relative period elongation ``(T̄ − T)/T = Ω/Ω̄ − 1``
+  with ``Ω̄ = atan2(B, A)``. Where the principal roots are real (a scheme that kills the
+  mode within a step, e.g. Bathe or generalized-α with ρ∞ = 0 at large Ω) there is no
+  period, and both are NaN;
+- the critical ``Ω`` above which ``ρ > 1`` (``2`` for ``semi-implicit``, ``0`` for
+  ``explicit``, ``1/√(γ/2 − β)`` for Newmark with ``2β < γ``, ``inf`` for the
+  unconditionally stable).
+
+:func:`mode_table` applies it to every mode of a beam at a chosen ``Δt``: which modes
+the step resolves and which it damps away.
+
+References
+----------
+.. [1] T. J. R. Hughes, *The Finite Element Method*, Dover, 2000, §9.2–9.3.
+.. [2] J. Chung, G. M. Hulbert, *J. Appl. Mech.* 60, 371–375, 1993, §3 and Figs. 1–3.
+.. [3] G. Noh, K. J. Bathe, *Comput. Struct.* 212, 299–310, 2019, §3.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike, NDArray
+
+from tumble import _checks
+from tumble.structural.alpha import AlphaScheme, AlphaState, Bathe, alpha_step, bathe_step
+from tumble.structural.schemes import Scheme, resolve_scheme
+from tumble.structural.stability import critical_omega
+from tumble.structural.stepping import State, reference_step
+from tumble.structural.system import LinearSystem
+
+
+class _Oscillator:
+    """The one-DOF system ``ẍ + 2ξΩ ẋ + Ω² x = 0`` (Δt = 1), duck-typed as a LinearSystem
+    for the reference steps (they call ``internal_forces``, read ``f``, ``M``, ``S``)."""
+
+    def __init__(self, omega: float, xi: float):
+        self.stiffness = omega * omega
+        self.M = sp.csr_matrix(np.ones((1, 1)))
+        self.S = sp.csr_matrix(np.full((1, 1), self.stiffness))
+        self.f = np.zeros(1)
+        self.C = None if xi == 0 else sp.csr_matrix(np.full((1, 1), 2 * xi * omega))
+
+    def internal_forces(self, x: NDArray, out: NDArray | None = None) -> NDArray:
+        return self.stiffness * x
+
+
+def _step_matrix(scheme: Scheme, omega: float, xi: float) -> NDArray:
+    """``G`` for one ``Ω``: the scheme's reference step applied to each unit state."""
+    system: Any = _Oscillator(omega, xi)
+    if isinstance(scheme, AlphaScheme):
+        return _alpha_matrix(scheme, system)
+    C = system.C
+    columns = []
+    for x, y in np.eye(2):
+        state = State.start(system, np.array([x]), np.array([y]))
+        if isinstance(scheme, Bathe):
+            solves = [_divide_by(float(A[0, 0])) for A in scheme.matrices(system, C, 1.0)]
+            bathe_step(state, scheme.coefficients(1.0), system, solves, C)
+        else:
+            k = scheme.increments(1.0)
+            mass = _identity if k.mass_solve else None
+            solve = _divide_by(float(scheme.matrix(system, C, 1.0)[0, 0]))
+            reference_step(state, k, system, solve, mass, C)
+        columns.append([state.x[0], state.y[0]])
+    return np.array(columns).T
+
+
+def _identity(b: NDArray) -> NDArray:
+    return b
+
+
+def _divide_by(pivot: float) -> Callable[[NDArray], NDArray]:
+    """The solve with the 1 × 1 step matrix ``[pivot]``."""
+    return lambda b: b / pivot
+
+
+def _alpha_matrix(scheme: AlphaScheme, system: Any) -> NDArray:
+    """``G`` on ``(x, y, a)`` for the generalized-α family (``M = 1``, so ``m = a``)."""
+    C = system.C
+    pivot = float(scheme.matrices(system, C, 1.0)[0][0, 0])
+    values = _alpha_values(scheme)
+    k_g, k_sa = values[2], values[3]
+    columns = []
+    for x, y, a in np.eye(3):
+        q = np.array([-system.stiffness * x])
+        r = q - (0.0 if C is None else C @ [y])
+        p = system.stiffness * np.array([k_g * y + k_sa * a])
+        state = AlphaState(np.array([x]), np.array([y]), q, p, np.array([a]), np.array([a]), r)
+        alpha_step(state, values, system, _divide_by(pivot), C)
+        columns.append([state.x[0], state.y[0], state.a[0]])
+    return np.array(columns).T
+
+
+def _alpha_values(scheme: AlphaScheme) -> tuple:
+    from tumble.structural.alpha import AlphaCoefficients
+
+    return AlphaCoefficients.of(*scheme.parameters, 1.0).values
+
+
+@dataclass(frozen=True, eq=False)
+class Amplification:
+    """A scheme's amplification on the oscillator, against ``Ω = ωΔt`` (module docstring).
+
+    Attributes
+    ----------
+    scheme : str
+    omega : ndarray, shape (n,)
+        ``Ω = ωΔt`` [rad].
+    xi : float
+        The oscillator's physical damping ratio ξ.
+    matrix : ndarray, shape (n, k, k)
+        ``G(Ω)`` acting on ``(x, Δt y)`` (k = 2) or ``(x, Δt y, Δt² a)`` (k = 3).
+    spectral_radius : ndarray, shape (n,)
+    damping_ratio : ndarray, shape (n,)
+        Algorithmic damping ratio ξ̄ (NaN where the principal roots are real).
+    period_elongation : ndarray, shape (n,)
+        ``(T̄ − T)/T`` (NaN where the principal roots are real).
+    critical_omega : float
+        ``Ω`` above which ``ρ > 1``: 0 never stable, ``inf`` always.
+    """
+
+    scheme: str
+    omega: NDArray[np.float64]
+    xi: float
+    matrix: NDArray[np.float64]
+    spectral_radius: NDArray[np.float64]
+    damping_ratio: NDArray[np.float64]
+    period_elongation: NDArray[np.float64]
+    critical_omega: float
+
+
+def amplification(scheme: str | Scheme, omega: ArrayLike, xi: float = 0.0) -> Amplification:
+    """The amplification matrix of ``scheme`` at each ``Ω = ωΔt``, and what follows from it.
+
+    Parameters
+    ----------
+    scheme : str or scheme object
+        A name from :data:`~tumble.structural.SCHEMES` or a scheme with its parameters.
+    omega : array_like, shape (n,)
+        ``Ω = ωΔt`` [rad], > 0.
+    xi : float, optional
+        Physical damping ratio ξ ∈ [0, 1) of the oscillator (Rayleigh damping of one mode).
+
+    Returns
+    -------
+    Amplification
+
+    Examples
+    --------
+    >>> out = amplification("newmark", [0.1, 1.0, 1e6])
+    >>> out.spectral_radius.round(12), bool(np.all(np.abs(out.damping_ratio) < 1e-12))
+    (array([1., 1., 1.]), True)
+    >>> float(out.period_elongation[1].round(6))   # Ω/(2 atan(Ω/2)) − 1
+    0.078405
+    >>> amplification("semi-implicit", [1.0]).critical_omega
+    2.0
+    """
+    scheme = resolve_scheme(scheme)
+    omega = np.atleast_1d(_checks.array("omega", omega, unit="rad", positive=True))
+    xi = _checks.non_negative("xi", xi)
+    if not xi < 1:
+        raise _checks.fail("xi", xi, "in [0, 1): an underdamped oscillator")
+    G = np.array([_step_matrix(scheme, float(w), xi) for w in omega])
+    eigenvalues = np.linalg.eigvals(G)
+    radius = np.abs(eigenvalues).max(axis=1)
+    principal = np.take_along_axis(eigenvalues, np.argmax(eigenvalues.imag, axis=1)[:, None], 1)
+    principal = principal[:, 0]
+    oscillating = principal.imag > 0
+    omega_bar = np.where(oscillating, np.angle(principal), np.nan)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        damping = -np.log(np.abs(principal) ** 2) / (2 * omega_bar)
+        elongation = omega / omega_bar - 1
+    return Amplification(scheme.name, omega, xi, G, radius, damping, elongation,
+                         float(critical_omega(scheme)))  # fmt: skip
+
+
+@dataclass(frozen=True, eq=False)
+class ModeTable:
+    """Each mode of a system under each scheme at one ``Δt`` (:func:`mode_table`).
+
+    Attributes
+    ----------
+    dt : float
+        Time step [s].
+    omega : ndarray, shape (n_modes,)
+        Natural frequencies ω [rad/s]; ``Ω = omega · dt``.
+    schemes : tuple of str
+    spectral_radius, damping_ratio, period_elongation : ndarray, shape (n_schemes, n_modes)
+        As :class:`Amplification`, per scheme and mode.
+    """
+
+    dt: float
+    omega: NDArray[np.float64]
+    schemes: tuple[str, ...]
+    spectral_radius: NDArray[np.float64]
+    damping_ratio: NDArray[np.float64]
+    period_elongation: NDArray[np.float64]
+
+
+def mode_table(
+    system: LinearSystem,
+    dt: float,
+    schemes: tuple[str | Scheme, ...] | None = None,
+    n_modes: int | None = None,
+) -> ModeTable:
+    """For a time step ``dt``: each mode's ``Ω = ωΔt`` and its fate under each scheme.
+
+    Parameters
+    ----------
+    system : LinearSystem
+    dt : float
+        Time step [s], > 0.
+    schemes : tuple, optional
+        Names or scheme objects; every scheme of :data:`~tumble.structural.SCHEMES` by
+        default.
+    n_modes : int, optional
+        The lowest this many modes (all by default).
+
+    Examples
+    --------
+    >>> from tumble.structural import cantilever
+    >>> beam = cantilever(1.0, 4, E=210e9, rho=7850, width=0.01, height=0.01)
+    >>> table = mode_table(beam, 1e-3, ("newmark", "bathe"), n_modes=2)
+    >>> (table.omega * table.dt).round(3)
+    array([0.052, 0.329])
+    >>> bool(abs(table.damping_ratio[0, 1]) < 1e-12), bool(table.damping_ratio[1, 1] > 0)
+    (True, True)
+    """
+    from tumble.structural.schemes import SCHEMES
+
+    dt = _checks.positive("dt", dt, "s")
+    n = system.n_dofs if n_modes is None else _checks.count("n_modes", n_modes)
+    omega = system.natural_frequencies(n)
+    chosen = tuple(resolve_scheme(s) for s in (SCHEMES.values() if schemes is None else schemes))
+    analyses = [amplification(s, omega * dt) for s in chosen]
+    return ModeTable(
+        dt,
+        omega,
+        tuple(s.name for s in chosen),
+        np.array([a.spectral_radius for a in analyses]),
+        np.array([a.damping_ratio for a in analyses]),
+        np.array([a.period_elongation for a in analyses]),
+    )

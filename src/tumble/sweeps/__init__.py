@@ -1,0 +1,19 @@
+"""Sweeps: one scenario over a grid (or a table) of options, on Dask, into one Zarr store.
+
+==============================  ==============================================================
+:func:`sweep`                   run the members on a Dask cluster; return the dataset
+:func:`make_plan`               check the grid before any work; the members' tasks
+:class:`Plan`                   a checked sweep
+:mod:`tumble.sweeps.store`      the store's layout, the template, regions, completion flags
+:mod:`tumble.sweeps.members`    how a task runs its members (``simulate_batch`` where it can)
+==============================  ==============================================================
+
+Dask and Zarr are imported only when a sweep runs.
+"""
+
+from __future__ import annotations
+
+from tumble.sweeps.plan import Plan, make_plan
+from tumble.sweeps.run import sweep
+
+__all__ = ["Plan", "make_plan", "sweep"]

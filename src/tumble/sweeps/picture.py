@@ -1,0 +1,75 @@
+"""A sweep's map: one summary variable over two swept dimensions (``tumble sweep --map``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from tumble import _checks
+
+
+def swept_dims(dataset) -> list[str]:
+    """The member dimensions with more than one value, in the store's order."""
+    grid = [dim for dim in dataset["done"].dims if dim != "member"]
+    return [dim for dim in grid if dataset.sizes[dim] > 1]
+
+
+def draw_map(dataset, variable: str, path: str | Path, *, title: str = "") -> Path:
+    """A heat map of ``variable`` over the two swept dimensions of a grid sweep.
+
+    Parameters
+    ----------
+    dataset : xarray.Dataset
+        A sweep's store (:func:`tumble.sweep`).
+    variable : str
+        A per-member variable: for a rigid-body sweep one of
+        :data:`~tumble.sweeps.members.SUMMARY` (``flip_period``, ``energy_error``,
+        ``wall_time``, ``status``, ``n_steps``); for a built-in, a number of its summary.
+    path : str or Path
+        Output PNG.
+    title : str
+        Figure title (default: the variable and the store's scenario source).
+
+    Raises
+    ------
+    ValueError
+        If ``variable`` is not a per-member variable, or the sweep has not exactly two swept
+        dimensions (other dimensions must have one value).
+    """
+    from tumble.viz.sweep import heat_maps
+
+    members = dataset["done"].dims
+    names = [name for name in dataset.data_vars if dataset[name].dims == members]
+    _checks.choice("map", variable, [name for name in names if name != "done"])
+    dims = swept_dims(dataset)
+    if len(dims) != 2:
+        raise _checks.fail(
+            "map", variable, "drawn over exactly two swept dimensions",
+            remedy=f"this sweep has {len(dims)}: {', '.join(dims) or 'none'}",
+        )  # fmt: skip
+    y, x = dims
+    values = dataset[variable].squeeze(drop=True).transpose(y, x).values.astype(float)
+    units = dataset[variable].attrs.get("units", "")
+    label = f"{variable} ({units})" if units else variable
+    heat_maps(
+        [(variable.replace("_", " "), values, label)], dataset[x].values, dataset[y].values,
+        path, xlabel=axis_label(dataset, x), ylabel=axis_label(dataset, y),
+        title=title or f"{variable} — {Path(dataset.attrs.get('scenario_source', '')).name}",
+        log={label} if variable == "energy_error" else (),
+    )  # fmt: skip
+    return Path(path)
+
+
+def axis_label(dataset, dim: str) -> str:
+    """A swept dimension's axis label: its option path and unit."""
+    path = dataset[dim].attrs.get("option_path", dim)
+    units = {
+        "omega0": "rad/s",
+        "spins": "rad/s",
+        "h": "s",
+        "t_end": "s",
+        "L0": "kg m²/s",
+        "x0": "m",
+        "v0": "m/s",
+    }
+    unit = next((u for key, u in units.items() if key in path.split(".")), "")
+    return f"{path} ({unit})" if unit else path
