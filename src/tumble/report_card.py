@@ -1214,8 +1214,9 @@ def markdown(card: ReportCard) -> str:
         "",
         f"Warm µs per accepted step on P1 (h = {STANDARD_H:g} s, adaptive rtol = "
         f"{STANDARD_RTOL:g}; best of {1 if card.quick else 3}); {card.first_call_note}. "
-        "tumble's fixed-step methods run compiled, its adaptive ones and scipy in Python, "
-        "MuJoCo in C called step by step from Python.",
+        "tumble's methods run compiled wherever their loads allow (as `simulate` chooses), "
+        "scipy in Python, MuJoCo in C called step by step from Python. An adaptive method's "
+        "cost per step includes `simulate`'s per-call work spread over few steps.",
         "",
         "| method | µs/step | first call (s) |",
         "| --- | ---: | ---: |",
