@@ -8,7 +8,7 @@ BENCH_STAMP := $(VENV)/.installed-bench
 DEMO ?= t-handle
 RUN_DIR ?= runs/$(DEMO)
 
-.PHONY: demo test browser bench lint format clean docs
+.PHONY: demo test browser bench report lint format clean docs
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -39,6 +39,12 @@ bench: $(BENCH_STAMP)
 	@dpkg -s libblas3 liblapack3 >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -q libblas3 liblapack3) \
 		|| echo "note: libblas3/liblapack3 missing; the OpenSees columns will be skipped"
 	OPENBLAS_NUM_THREADS=1 $(BIN)/python benchmarks/run_all.py
+
+# The integrator report card (tumble report, about 5 minutes): every method of METHODS beside
+# scipy and MuJoCo (the bench extra); docs/report.md is its report.md, with the machine noted.
+report: $(BENCH_STAMP)
+	OPENBLAS_NUM_THREADS=1 $(BIN)/tumble report --out runs/report
+	cp runs/report/report.md docs/report.md
 
 # The documentation site (Sphinx, docs/conf.py) in build/docs/html/index.html; warnings are errors.
 docs: $(STAMP)

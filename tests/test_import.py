@@ -77,6 +77,8 @@ def test_every_public_name_resolves_to_its_module_object(name):
         if name in {"ButcherTableau", "OdeResult", "Status", "solve"}
         else "tumble.sweeps"
         if name == "sweep"
+        else "tumble.report_card"
+        if name == "report"
         else "tumble.rigid"
     )
     if name in {"exact", "mass", "meshes", "so3", "structural"}:

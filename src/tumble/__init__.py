@@ -27,6 +27,7 @@ Modules
 :mod:`tumble.meshes`                trimesh meshes of the same shapes; a mesh's mass properties
 :mod:`tumble.exact`                 exact references: sphere, projectile, free body
 :mod:`tumble.structural`            finite-element beams and their time-stepping schemes
+:func:`report`                      the integrator report card: every method measured
 ==================================  ==========================================================
 
 Every submodule and name here is imported on first use (PEP 562), so ``import tumble`` is
@@ -49,6 +50,7 @@ if TYPE_CHECKING:  # what static type checkers see; at run time __getattr__ impo
     from tumble import viz as viz
     from tumble._version import __version__ as __version__
     from tumble.ode import ButcherTableau, OdeResult, Status, solve
+    from tumble.report_card import report as report
     from tumble.rigid import (
         METHODS,
         BatchTrajectory,
@@ -87,6 +89,7 @@ __all__ = [
     "simulate_batch",
     "so3",
     "solve",
+    "report",
     "structural",
     "sweep",
 ]
@@ -125,6 +128,7 @@ _NAMES = {
         ],
         "tumble.rigid",
     ),
+    "report": "tumble.report_card",
     "sweep": "tumble.sweeps",
     "__version__": "tumble._version",
 }

@@ -562,5 +562,37 @@ def _vector(values) -> str:
     return " ".join(f"{v: .5e}" for v in values)
 
 
+@app.command("report")
+def report_card(
+    quick: Annotated[
+        bool, typer.Option("--quick", help="Shorter long runs, one timing: under a minute.")
+    ] = False,
+    out: Annotated[Path, typer.Option(help="Folder for report.md, .html, .nc.")] = Path(
+        "runs/report"
+    ),
+) -> None:
+    """The integrator report card: every method measured on the same problems, peers beside."""
+    from tumble.report_card import report
+
+    with _reported():
+        card = report(out, quick=quick, progress=console.is_terminal)
+    table = Table(title=f"report card: {len(card.results)} methods in {card.seconds:.0f} s",
+                  box=None)  # fmt: skip
+    for column in ("method", "order declared", "measured", "energy (P1)", "declaration"):
+        table.add_column(column)
+    for result in card.results:
+        table.add_row(
+            result.row.name, f"{result.row.order:g}", f"{result.order.measured:.2f}",
+            result.free.energy_law,
+            "[red]contradicted[/]" if result.contradictions else "agrees",
+        )  # fmt: skip
+    console.print(table)
+    for name, why in card.contradictions.items():
+        errors.print(f"contradiction: {name}:", style="bold red", end=" ")
+        errors.print("; ".join(why), markup=False, highlight=False, soft_wrap=True)
+    for name in ("report.md", "report.html", "report.nc"):
+        console.print(f"{name}: {Path(out) / name}", highlight=False)
+
+
 def main() -> None:  # pragma: no cover - console-script entry
     app()

@@ -136,12 +136,14 @@ class Method:
         ``"angular_momentum"``: every method steps ``L̇ = τ`` linearly (or kicks it), so
         without torque ``L`` is constant; ``"orthogonality"``: R stays a rotation (``lie``,
         ``quat`` and ``split`` families, which never leave SO(3) or renormalise onto it);
+        ``"casimir"``: the body momentum's norm ``|RᵀL| = |L|``, the Casimir of the
+        Lie–Poisson equation (the same families: it follows from R staying a rotation);
         ``"energy"``: the kinetic energy of the free body (``midpoint-lp``, ``dmv`` and the
-        methods on the exact flow).
+        methods on the exact flow). :mod:`tumble.report_card` measures each claim.
         """
         kept = {"angular_momentum"}
         if self.family in ("lie", "quat", "split"):
-            kept.add("orthogonality")
+            kept |= {"orthogonality", "casimir"}
         if self.flow in ("midpoint", "dmv", "exact"):
             kept.add("energy")
         return frozenset(kept)
