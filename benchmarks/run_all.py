@@ -24,7 +24,14 @@ sys.path.insert(0, str(HERE))
 
 from _timing import load, machine, versions  # noqa: E402
 
-BENCHMARKS = ["bench_rigid", "bench_geometric", "bench_structural", "bench_ode", "bench_import"]
+BENCHMARKS = [
+    "bench_rigid",
+    "bench_geometric",
+    "bench_structural",
+    "bench_ode",
+    "bench_import",
+    "bench_cold",
+]
 
 
 def section(name: str, argv: list[str]) -> str:
