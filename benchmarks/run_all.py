@@ -30,6 +30,7 @@ BENCHMARKS = [
     "bench_structural",
     "bench_ode",
     "bench_import",
+    "bench_call",
     "bench_cold",
 ]
 

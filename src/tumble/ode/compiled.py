@@ -77,6 +77,7 @@ _INLINE: dict[str, Any] = dict(_JIT, inline="always")
 _STEP_FACTOR = njit(**_INLINE)(control.step_factor)
 _MINIMUM_STEP = njit(**_INLINE)(control.minimum_step)
 _GRID_TIME = njit(**_INLINE)(control.grid_time)
+_INITIAL_STEP = njit(**_INLINE)(control.initial_step)
 
 
 class Tableau:
@@ -173,7 +174,8 @@ def _loop(fun, tab, flags, grid, k, t, t1, h, rtol, atol, settings, y, f, steps,
     ``_adaptive`` (``flags[0]``) or ``_fixed`` on ``grid = (t0, t1, h, n)`` from its step
     ``k``.
 
-    ``y`` and ``f`` (``fun`` at ``y``) are updated in place; every accepted step is
+    ``h <= 0`` asks for the first step (:func:`tumble.ode.control.initial_step`, compiled
+    from it). ``y`` and ``f`` (``fun`` at ``y``) are updated in place; every accepted step is
     recorded in ``out = (t, y, Q, nfev, rejected)`` (``Q`` when ``flags[3]``: the step's
     interpolant, :func:`tumble.ode.dense.step_coefficients`). ``settings`` is ``(safety,
     min_factor, max_factor, order)``. Returns ``(recorded, t, h_next, k, rejected, code,
@@ -187,6 +189,9 @@ def _loop(fun, tab, flags, grid, k, t, t1, h, rtol, atol, settings, y, f, steps,
     t0_grid, t1_grid, h_grid, n_grid = grid
     ts, ys, Qs, nfevs, rejects = out
     s, n, m = b.shape[0], y.shape[0], dense_c.shape[0]
+    if adaptive and h <= 0.0:  # the first step, chosen as solve's Python path does
+        h = _INITIAL_STEP(fun, t, y, f, order, rtol, atol)
+        nfev += 1
     K, z, y_new, err = np.empty((s, n)), np.empty(n), np.empty(n), np.empty(n)
     X = np.empty((P.shape[0], n))
     count, after_rejection = 0, False
@@ -307,7 +312,7 @@ def march(
     y0: np.ndarray,
     f0: np.ndarray,
     *,
-    h: float,
+    h: float | None,
     nfev: int,
     rtol: float,
     atol: np.ndarray,
@@ -317,8 +322,9 @@ def march(
 ) -> CompiledOutcome:
     """Run :func:`tumble.solve` compiled: ``fun`` a numba function, ``f0 = fun(t0, y0)``.
 
-    ``h`` is the fixed step, or an adaptive run's first step; ``nfev`` the evaluations made
-    so far (``f0``, the first step's choice). Returns what :func:`tumble.ode.driver.march`
+    ``h`` is the fixed step, or an adaptive run's first step (None: chosen in the compiled
+    loop, as :func:`~tumble.ode.control.initial_step` does); ``nfev`` the evaluations made so
+    far (``f0``). Returns what :func:`tumble.ode.driver.march`
     would have, for :func:`tumble.solve` to wrap.
     """
     t0, t1 = t_span
@@ -332,12 +338,14 @@ def march(
     status, message = Status.SUCCESS, Status.SUCCESS.message
     steps = rejected = k = 0
     t = t0
-    atol_n = np.broadcast_to(np.asarray(atol, dtype=float), (n,)).copy()
+    atol_n = np.full(n, float(atol)) if np.ndim(atol) == 0 else np.array(atol, dtype=float)
     settings = (control.SAFETY, control.MIN_FACTOR, control.MAX_FACTOR, tableau.error_order)
     if tableau.adaptive:
+        h = 0.0 if h is None else h
         grid = (t0, t1, h, 0)
         size = EVENT_BLOCK if events else FIRST_BLOCK
     else:
+        assert h is not None
         grid = (t0, t1, h, control.fixed_step_count(t0, t1, h))
         check_record_size(t1 - t0, h, 1, max_steps, (y0,))
         size = min(grid[3], max_steps) + 1

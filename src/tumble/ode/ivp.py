@@ -112,15 +112,12 @@ def _solve_compiled(
     y: np.ndarray, h: float | None, rtol: float, atol: np.ndarray, events: list,
     dense_output: bool, max_steps: int,
 ) -> OdeResult:  # fmt: skip
-    """:func:`solve` with a compiled ``fun``: the same first evaluations, then the loop of
-    :func:`tumble.ode.compiled.march`."""
+    """:func:`solve` with a compiled ``fun``: ``f(t0, y0)`` (its shape checked), then the
+    loop of :func:`tumble.ode.compiled.march` (which chooses the first step if need be)."""
     from tumble.ode import compiled  # imports numba: only for a compiled fun
 
-    t0 = t_span[0]
-    f0 = counted(t0, y)
-    if h is None:
-        h = initial_step(counted, t0, y, f0, tableau.error_order, rtol, atol)
-    out = compiled.march(counted.fun, tableau, t_span, y, f0, h=float(h), nfev=counted.count,
+    f0 = counted(t_span[0], y)
+    out = compiled.march(counted.fun, tableau, t_span, y, f0, h=h, nfev=counted.count,
                          rtol=rtol, atol=atol, events=events, dense_output=dense_output,
                          max_steps=max_steps)  # fmt: skip
     return OdeResult(
