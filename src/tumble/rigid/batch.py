@@ -1,10 +1,13 @@
 """``simulate_batch``: many bodies (or many initial states of one body) in one compiled call.
 
-Every body runs the same compiled loop as :func:`~tumble.rigid.simulate` (the kernels of
-:mod:`tumble.rigid.kernels`), one body per thread (numba ``prange``), so body ``k`` of a batch
-has the numbers of ``simulate`` run alone with body ``k``'s arguments. The initial states are
-checked and built for all bodies at once with NumPy (the same operations ``simulate`` applies
-to one body).
+Body ``k`` of a batch has, bit for bit, the numbers of :func:`~tumble.rigid.simulate` run
+alone with body ``k``'s arguments. The ``lie`` and ``quat`` methods (``rkmk4``, ``rk4-quat``,
+…) run batches of at least :data:`SOA_MIN_BODIES` bodies in the structure-of-arrays loops of
+:mod:`tumble.rigid.soa` (bodies as columns, vectorised, the one-body loop's arithmetic in the
+same order); the other methods, and smaller batches, run the one-body loop of
+:mod:`tumble.rigid.kernels` once per body, one body per thread (numba ``prange``). The
+initial states are checked and built for all bodies at once with NumPy (the same operations
+``simulate`` applies to one body).
 """
 
 from __future__ import annotations
