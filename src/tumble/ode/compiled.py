@@ -25,12 +25,15 @@ every tableau of :data:`~tumble.ode.tableaux.TABLEAUX`):
   events, so a terminal event wastes at most one block of steps beyond it; the result is cut
   at the event with the counters (``nfev``, ``n_steps``, ``n_rejected``) of that step.
 
-The loops take ``fun`` as an argument, so numba compiles them once per right-hand side and
-process: numba keys a function that receives another by that function's identity, so such a
-loop can never come from the on-disk cache (``cache=True`` would only add an index entry at
-each run). Everything they call is cached. After the first call the loop is called through
-its compiled entry point (about 1 µs instead of numba's 14 µs dispatch of a function
-argument).
+This is the one step loop beside :func:`tumble.ode.driver.march`: the driver runs compiled
+blocks only without events and dense output, and here both stay compiled.
+
+The loop, :func:`_loop`, takes ``fun`` as an argument, so numba compiles it once per
+right-hand side and process (2 to 5 s here, ``benchmarks/bench_cold.py``): numba keys a
+function that receives another by that function's identity, so such a loop can never come
+from the on-disk cache (``cache=True`` would only add an index entry at each run). What it
+calls is cached. After the first call the loop is called through its compiled entry point
+(about 1 µs instead of numba's 14 µs dispatch of a function argument).
 
 References
 ----------
