@@ -32,6 +32,8 @@ BENCHMARKS = [
     "bench_ode",
     "bench_import",
     "bench_sweep",
+    "bench_call",
+    "bench_cold",
 ]
 
 

@@ -1,5 +1,8 @@
 """simulate_batch: the numbers of N single simulate runs, a body axis, and clear refusals."""
 
+import re
+
+import numba
 import numpy as np
 import pytest
 
@@ -14,7 +17,10 @@ from tumble.rigid import (
     Torque,
     simulate,
     simulate_batch,
+    soa,
 )
+from tumble.rigid.batch import SOA_FAMILIES, SOA_MIN_BODIES
+from tumble.rigid.soa import BLOCK
 
 FIXED = [name for name, method in METHODS.items() if not method.adaptive and not method.exact]
 """The fixed-step methods that take loads (the exact flow takes none: test_rigid_geometric)."""
@@ -216,3 +222,66 @@ def test_bodies_are_counted_and_checked(bodies):
         simulate_batch(bodies, 1.0, h=0.1, omega0=OMEGA0[:2])
     with pytest.raises(ValueError, match=r"body_or_bodies\[1\]"):
         simulate_batch([bodies[0], "body"], 1.0, h=0.1)
+
+
+SOA = [name for name in FIXED if METHODS[name].family in SOA_FAMILIES]
+"""The fixed-step methods whose batches run in the structure-of-arrays loops."""
+
+
+@pytest.mark.parametrize("method", SOA)
+def test_columns_of_bodies_across_blocks_match_single_runs_bit_for_bit(body, method):
+    """More bodies than a block (the last one partial), spins up to 60 rad/s so that many
+    stage angles pass SERIES_ANGLE (the loops' scalar branch). (A body that stops alone:
+    test_a_body_that_blows_up_stops_alone and the two after it, which run these loops.)"""
+    n = BLOCK + 37  # >= SOA_MIN_BODIES
+    rng = np.random.default_rng(3)
+    omega0 = rng.normal(size=(n, 3)) * np.geomspace(0.1, 60.0, n)[:, None]
+    batch = simulate_batch(body, 0.05, method=method, h=0.01, omega0=omega0, forces=LOADS)
+    assert np.all(batch.status == 0)
+    for k in range(n):
+        single = simulate(body, 0.05, method=method, h=0.01, omega0=omega0[k], forces=LOADS)
+        for name in ("t", "R", "L_world", "x", "v"):
+            np.testing.assert_array_equal(getattr(batch[k], name), getattr(single, name), name)
+
+
+@pytest.mark.parametrize(
+    "loop", ["_lie_field_soa", "_quat_field_soa", "_lie_advance_soa", "_stage_state"]
+)
+def test_structure_of_arrays_loops_compile_to_packed_instructions(loop):
+    """Each loop over bodies is vectorised: compiled afresh (cached code cannot be
+    inspected), its assembly multiplies four or eight doubles at once (vmulpd on ymm/zmm)."""
+    n, rng = 16, np.random.default_rng(0)
+    arguments = {
+        "_lie_field_soa": (True, rng.normal(size=(12, n)), rng.normal(size=(9, n)),
+                           rng.normal(size=(9, n)), np.empty((4, n)), np.empty((4, 12, n)), 1),
+        "_quat_field_soa": (rng.normal(size=(13, n)), np.empty((9, n)), rng.normal(size=(9, n)),
+                            np.empty((4, 13, n)), 1),
+        "_lie_advance_soa": (rng.normal(size=(12, n)), np.empty((12, n)),
+                             rng.normal(size=(9, n)), np.empty((4, n)), np.ones(n, dtype=bool)),
+        "_stage_state": (np.eye(4), 2, 0.1, rng.normal(size=(12, n)),
+                         rng.normal(size=(4, 12, n)), np.empty((12, n)), np.empty(n)),
+    }[loop]  # fmt: skip
+    fresh = numba.njit(error_model="numpy")(getattr(soa, loop).py_func)
+    fresh(*arguments)
+    assembly = "".join(fresh.inspect_asm().values())
+    packed = re.findall(r"\bvmulpd\s+[^\n]*%[yz]mm", assembly)
+    assert len(packed) >= 4, f"{loop}: {len(packed)} packed multiplies"
+
+
+@pytest.mark.parametrize("record_every", [1, 3])
+@pytest.mark.parametrize("method", SOA)
+def test_a_body_stopped_among_columns_ends_as_its_single_run(body, method, record_every):
+    """As test_a_body_stopped_after_many_steps_..., with enough bodies for the columns:
+    body 1 overflows in step 80 and keeps its step-79 state, the others go on."""
+    n = SOA_MIN_BODIES + 3
+    x0, v0 = np.zeros((n, 3)), np.tile([1.0, 0.0, 0.0], (n, 1))
+    x0[1], v0[1] = [1e308, 0.0, 0.0], [1e307, 0.0, 0.0]
+    omega0 = np.resize(OMEGA0, (n, 3))
+    options = dict(method=method, h=0.1, record_every=record_every)
+    batch = simulate_batch(body, 10.0, x0=x0, v0=v0, omega0=omega0, **options)
+    assert list(batch.status[:3]) == [0, -1, 0] and list(batch.n_steps[:3]) == [100, 79, 100]
+    for k in (0, 1, 2):
+        single = simulate(body, 10.0, x0=x0[k], v0=v0[k], omega0=omega0[k], **options)
+        for name in FIELDS:
+            np.testing.assert_array_equal(getattr(batch[k], name), getattr(single, name), name)
+        assert batch[k].message == single.message

@@ -100,6 +100,40 @@ class RungeKutta(Stepper):
         return StepInterpolant(t_old, h, old, Q)
 
 
+def is_compiled(fun: object) -> bool:
+    """Whether ``fun`` is a numba-compiled function (``@numba.njit``), without importing
+    numba: then :func:`solve` runs compiled (:mod:`tumble.ode.compiled`)."""
+    kind = type(fun)
+    return kind.__name__ == "CPUDispatcher" and kind.__module__.startswith("numba")
+
+
+def _solve_compiled(
+    counted: _CountedFunction, tableau: ButcherTableau, t_span: tuple[float, float],
+    y: np.ndarray, h: float | None, rtol: float, atol: np.ndarray, events: list,
+    dense_output: bool, max_steps: int,
+) -> OdeResult:  # fmt: skip
+    """:func:`solve` with a compiled ``fun``: ``f(t0, y0)`` (its shape checked), then the
+    loop of :func:`tumble.ode.compiled.march` (which chooses the first step if need be)."""
+    from tumble.ode import compiled  # imports numba: only for a compiled fun
+
+    f0 = counted(t_span[0], y)
+    out = compiled.march(counted.fun, tableau, t_span, y, f0, h=h, nfev=counted.count,
+                         rtol=rtol, atol=atol, events=events, dense_output=dense_output,
+                         max_steps=max_steps)  # fmt: skip
+    return OdeResult(
+        t=out.t,
+        y=out.y.T,
+        t_events=[np.array(ts, dtype=float) for ts in out.t_events],
+        y_events=[np.array(ys, dtype=float).reshape(-1, y.size) for ys in out.y_events],
+        nfev=out.nfev,
+        n_steps=out.n_steps,
+        n_rejected=out.n_rejected,
+        status=out.status,
+        message=out.message,
+        sol=out.sol,
+    )
+
+
 def _lookup(method: str) -> ButcherTableau:
     return TABLEAUX[_checks.choice("method", method, TABLEAUX, remedy="see tumble.ode.TABLEAUX")]
 
@@ -162,7 +196,9 @@ def solve(
     Parameters
     ----------
     fun : callable
-        Right-hand side ``fun(t, y) -> ndarray, shape (n,)``.
+        Right-hand side ``fun(t, y) -> ndarray, shape (n,)``. A numba-compiled one
+        (``@numba.njit``, returning a float array) makes the whole run compiled
+        (:mod:`tumble.ode.compiled`), with the same result to round-off.
     t_span : (float, float)
         ``(t0, t1)`` with ``t1 > t0``. The last step lands exactly on ``t1``.
     y0 : array_like, shape (n,)
@@ -224,6 +260,9 @@ def solve(
     events = _checks.callables("events", events)
     dense_output = _checks.flag("dense_output", dense_output)
     counted = _CountedFunction(fun, y.size)
+    if is_compiled(fun):
+        return _solve_compiled(counted, tableau, (t0, t1), y, h, float(rtol), atol_array,
+                               events or [], dense_output, int(max_steps))  # fmt: skip
     stepper = RungeKutta(counted, tableau, t0, y)
     control = None
     if tableau.adaptive:

@@ -1,10 +1,13 @@
 """``simulate_batch``: many bodies (or many initial states of one body) in one compiled call.
 
-Every body runs the same compiled loop as :func:`~tumble.rigid.simulate` (the kernels of
-:mod:`tumble.rigid.kernels`), one body per thread (numba ``prange``), so body ``k`` of a batch
-has the numbers of ``simulate`` run alone with body ``k``'s arguments. The initial states are
-checked and built for all bodies at once with NumPy (the same operations ``simulate`` applies
-to one body).
+Body ``k`` of a batch has, bit for bit, the numbers of :func:`~tumble.rigid.simulate` run
+alone with body ``k``'s arguments. The ``lie`` and ``quat`` methods (``rkmk4``, ``rk4-quat``,
+…) run batches of at least :data:`SOA_MIN_BODIES` bodies in the structure-of-arrays loops of
+:mod:`tumble.rigid.soa` (bodies as columns, vectorised, the one-body loop's arithmetic in the
+same order); the other methods, and smaller batches, run the one-body loop of
+:mod:`tumble.rigid.kernels` once per body, one body per thread (numba ``prange``). The
+initial states are checked and built for all bodies at once with NumPy (the same operations
+``simulate`` applies to one body).
 """
 
 from __future__ import annotations
@@ -517,15 +520,46 @@ class BatchStepper(Stepper):
             Z, RN = np.array(state[1], dtype=float), np.array(state[0], dtype=float)
         else:
             Z, RN = self.chart.pack(*state)
-        announce_compilation(self.batch, f"the batch loop of {self.method.name}")
-        self.batch(self.problem, grid, Z, RN, every, records, self.counts, self.failed,
-                   self.causes)  # fmt: skip
+        if self.method.family in SOA_FAMILIES and n_bodies >= SOA_MIN_BODIES:
+            Z, RN = _march_columns(self.method, self.problem, grid, Z, RN, every, records,
+                                   self.counts, self.failed)  # fmt: skip
+        else:
+            announce_compilation(self.batch, f"the batch loop of {self.method.name}")
+            self.batch(self.problem, grid, Z, RN, every, records, self.counts, self.failed,
+                       self.causes)  # fmt: skip
         q = records.q if self._quat else np.empty((n_bodies, size, 0))
         return Block(
             t=_record_times(grid, every),
             records=(records.R, records.Y, q),
             state=(RN, Z) if self.split else self.chart.read(Z, RN),
         )
+
+
+SOA_FAMILIES = ("lie", "quat")
+"""The charts whose batches run in the structure-of-arrays loops of :mod:`tumble.rigid.soa`
+(bodies as columns, vectorised; the numbers of the one-body loop, bit for bit)."""
+
+SOA_MIN_BODIES = 32
+"""Fewer bodies run one per thread: with a handful of columns the vector loops' set-up costs
+more than the one-body loop (measured: one body 0.14× as fast in the columns, 10³ bodies
+2.5×)."""
+
+
+def _march_columns(method: Method, problem, grid: Grid, Z, RN, every, records, counts, failed):
+    """:func:`tumble.rigid.soa.run_batch` on the batch's state ``Z`` (N, nz), ``RN``
+    (N, 3, 3): the bodies as columns, and back."""
+    from tumble.rigid.soa import run_batch
+
+    n = len(Z)
+    columns = np.ascontiguousarray(Z.T)
+    attitudes = np.ascontiguousarray(RN.reshape(n, 9).T)
+    inv_I = np.ascontiguousarray(problem.inv_I.reshape(n, 9).T)
+    F = np.ascontiguousarray(problem.F.T)
+    mass = np.ascontiguousarray(problem.m, dtype=float)
+    announce_compilation(run_batch, f"the batch loop of {method.name}")
+    run_batch(method.family == "quat", problem, grid, columns, attitudes, inv_I, mass, F, every,
+              records, counts, failed)  # fmt: skip
+    return np.ascontiguousarray(columns.T), np.ascontiguousarray(attitudes.T).reshape(n, 3, 3)
 
 
 RECORD_SHAPES = ((), (3, 3), (4,), (9,))
