@@ -150,14 +150,20 @@ def test_killed_worker_leaves_the_sweep_to_the_other(cluster, tmp_path):
 
 
 def test_output_larger_than_the_worker_memory_limit_completes(tmp_path):
-    """One worker limited to 400 MB writes 450 MB of members: each task writes its region
-    and forgets it, so the worker is never restarted (same process before and after)."""
+    """One worker limited to 800 MB writes 845 MB of members: each task writes its region
+    and forgets it, so the worker is never restarted (same process before and after).
+
+    The limit leaves room for a worker that compiles the kernels itself (a fresh clone: about
+    330 MB resident before any member), and pausing is off: a paused worker that holds no
+    data never resumes, and the sweep would wait for ever. Terminating at 95 % stays on."""
+    import dask
     from distributed import Client, LocalCluster
 
-    limit = 400e6
-    members = 1280  # x 2001 samples x 176 bytes: 451 MB
+    limit = 800e6
+    members = 2400  # x 2001 samples x 176 bytes: 845 MB
     options = {**OPTIONS, "h": 0.005, "t_end": 10.0, "record_every": 1}
     with (
+        dask.config.set({"distributed.worker.memory.pause": False}),
         LocalCluster(n_workers=1, threads_per_worker=1, memory_limit=limit,
                      dashboard_address=":0") as cluster,
         Client(cluster) as client,
