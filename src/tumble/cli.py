@@ -390,7 +390,8 @@ def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool)
                 _mode_cell(radius[k], v[k])
                 for radius, v in zip(table.spectral_radius, values, strict=True)
             ]
-            grid.add_row(str(k + 1), f"{w:.4g}", f"{w * step:.3g}", *cells)
+            omega = f"{w:.0f}" if w >= 100 else f"{w:.4g}"  # no exponent: the column stays narrow
+            grid.add_row(str(k + 1), omega, f"{w * step:.3g}", *cells)
         console.print(grid)
     console.print(f"plots: {path}, {folder / 'schemes_vs_exact.png'}", highlight=False)
 
