@@ -12,9 +12,22 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from tumble import _checks
+
+MIN_RTOL = 100 * np.finfo(float).eps
+"""The smallest ``rtol`` accepted (100 machine epsilons, 2.2e-14): below it round-off decides."""
+
 SAFETY = 0.9
 MIN_FACTOR = 0.2
 MAX_FACTOR = 10.0
+
+
+def relative_tolerance(rtol: object) -> float:
+    """``rtol`` checked: finite and at least :data:`MIN_RTOL` (the ValueError names it)."""
+    value = _checks.positive("rtol", rtol)
+    if value < MIN_RTOL:
+        raise _checks.fail("rtol", rtol, ">= 100 × machine epsilon (2.2e-14)", remedy="raise it")
+    return value
 
 
 def error_norm(

@@ -106,14 +106,25 @@ class DenseOutput:
         self.interpolants = list(interpolants)
         self.t_min, self.t_max = float(self.ts[0]), float(self.ts[-1])
 
-    def __call__(self, t: float | np.ndarray) -> np.ndarray:
-        """Evaluate the solution at ``t``: scalar → (n,), array of m times → (n, m)."""
+    def steps(self, t: float | np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(t, index)``: the times as an array, and the step whose interpolant holds each.
+
+        Raises
+        ------
+        ValueError
+            For a time outside the solved interval.
+        """
         t_array = np.asarray(t, dtype=float)
         if np.any(t_array < self.t_min) or np.any(t_array > self.t_max):
             raise ValueError(
                 f"t={t!r} is outside the solved interval [{self.t_min}, {self.t_max}]"
             )
         index = np.clip(np.searchsorted(self.ts, t_array, side="right") - 1, 0, len(self) - 1)
+        return t_array, index
+
+    def __call__(self, t: float | np.ndarray) -> np.ndarray:
+        """Evaluate the solution at ``t``: scalar → (n,), array of m times → (n, m)."""
+        t_array, index = self.steps(t)
         if t_array.ndim == 0:
             return self.interpolants[int(index)](float(t_array))
         columns = [

@@ -370,6 +370,9 @@ class _Run:
     def fail(self, message: str) -> None:
         self.status, self.message = Status.FAILED, message
 
+    def max_steps_message(self) -> str:
+        return f"max_steps={self.max_steps} reached at t={self.t!r}; increase `max_steps`"
+
     def record(self) -> None:
         """Sample the current state (replacing a sample at the same time: before a jump)."""
         if self.times and self.times[-1][-1] == self.t:
@@ -453,7 +456,7 @@ def _fixed(run: _Run, t1: float, h: float) -> bool:
     stepper, grid = run.stepper, Grid(run.t, t1, h, fixed_step_count(run.t, t1, h))
     for k in range(1, grid.n + 1):
         if run.n_steps >= run.max_steps:
-            run.fail(f"max_steps={run.max_steps} reached at t={run.t!r}; increase `max_steps`")
+            run.fail(run.max_steps_message())
             return False
         t_old, old, t_new = run.t, run.state, grid.time(k)
         new, _ = stepper.step(t_old, old, t_new - t_old)
@@ -471,7 +474,7 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
     rejected = False
     while run.t < t1:
         if run.n_steps >= run.max_steps:
-            run.fail(f"max_steps={run.max_steps} reached at t={run.t!r}; increase `max_steps`")
+            run.fail(run.max_steps_message())
             return False, h
         t_old, old = run.t, run.state
         h_min = minimum_step(t_old)
@@ -518,7 +521,7 @@ def _adaptive_blocks(run: _Run, t1: float, h: float, control: Control) -> tuple[
             run.fail(_minimum_step_message(run.t, minimum_step(run.t), block.finite))
             return False, h
         if run.n_steps >= run.max_steps and run.t < t1:
-            run.fail(f"max_steps={run.max_steps} reached at t={run.t!r}; increase `max_steps`")
+            run.fail(run.max_steps_message())
             return False, h
         if run.progress is not None:
             run.progress(run.t)
@@ -555,7 +558,7 @@ def _blocks(run: _Run, t1: float, h: float) -> bool:
         if run.progress is not None:
             run.progress(run.t)
     if last < grid.n:
-        run.fail(f"max_steps={run.max_steps} reached at t={run.t!r}; increase `max_steps`")
+        run.fail(run.max_steps_message())
         return False
     return True
 

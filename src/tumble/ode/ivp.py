@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tumble import _checks
-from tumble.ode.control import initial_step
+from tumble.ode.control import initial_step, relative_tolerance
 from tumble.ode.dense import DenseOutput, StepInterpolant, step_coefficients
 from tumble.ode.driver import Control, Status, Stepper, march
 from tumble.ode.events import Event
@@ -169,9 +169,7 @@ def _check_step(h, tableau: ButcherTableau) -> float | None:
 
 
 def _check_tolerances(rtol, atol, n: int) -> np.ndarray:
-    _checks.positive("rtol", rtol)
-    if rtol < 100 * np.finfo(float).eps:
-        raise _checks.fail("rtol", rtol, ">= 100 × machine epsilon (2.2e-14)", remedy="raise it")
+    relative_tolerance(rtol)
     atol_array = _checks.array("atol", atol)
     if atol_array.shape not in ((), (n,)) or np.any(atol_array < 0):
         raise _checks.fail("atol", atol, f">= 0 and finite, a scalar or of shape ({n},)")

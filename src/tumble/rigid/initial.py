@@ -7,6 +7,7 @@ import warnings
 import numpy as np
 
 from tumble import _checks, so3
+from tumble.ode.control import relative_tolerance
 from tumble.rigid.body import RigidBody
 from tumble.rigid.methods import Method
 
@@ -48,10 +49,7 @@ def check_steps(method: Method, h, rtol, atol) -> tuple[float | None, float, np.
                 f"{method.name!r} takes a fixed step h",
             )
         return h, 0.0, None
-    rtol = _checks.positive("rtol", DEFAULT_RTOL if rtol is None else rtol)
-    if rtol < MIN_RTOL:
-        raise _checks.fail("rtol", rtol, f">= {MIN_RTOL:.3g} (100 machine epsilons)",
-                           remedy="double precision cannot resolve less")  # fmt: skip
+    rtol = relative_tolerance(DEFAULT_RTOL if rtol is None else rtol)
     if atol is None:
         return h, rtol, None
     checked = _checks.array("atol", atol)
@@ -66,9 +64,6 @@ def check_steps(method: Method, h, rtol, atol) -> tuple[float | None, float, np.
 
 DEFAULT_RTOL = 1e-6
 """``rtol`` of the adaptive methods when none is given."""
-
-MIN_RTOL = 100 * np.finfo(float).eps
-"""The smallest ``rtol`` accepted: below it round-off decides."""
 
 
 def adaptive_names() -> str:

@@ -158,10 +158,11 @@ def simulate(
         (``rkmk45``, ``rkmk-dopri5``; chosen from ω and rtol when omitted).
     rtol : float, optional
         Relative tolerance of the adaptive methods (default 1e-6, at least 2.2e-14); refused
-        for fixed-step methods. Each step's rotation is kept right to ``rtol`` radians (the
-        attitude's error is measured in radians, against ``rtol`` alone), and x, p, L to
-        ``atol + rtol |y|`` (:func:`tumble.rigid.charts.error_norm`). The global error
-        falls with rtol down to round-off (docs/rigid-body.md: the table against scipy).
+        for fixed-step methods. The attitude's error is measured in radians against ``rtol``
+        alone, x, p, L against ``atol + rtol |y|`` (:func:`tumble.rigid.charts.error_norm`),
+        and each step gets its share ``h/T`` of that (error per unit step), so that ``rtol``
+        bounds the run's attitude error, not each step's; it falls with rtol down to
+        round-off (docs/rigid-body.md: the table against scipy).
     atol : float or array_like, shape (9,), optional
         Absolute tolerance of x (m), p (kg m/s) and L (kg m²/s); it never applies to the
         attitude. Default: ``rtol`` times each part's characteristic size

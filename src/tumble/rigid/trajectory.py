@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 
 from tumble import so3
+from tumble.ode.dense import DenseOutput
 from tumble.ode.driver import Status
 from tumble.rigid.body import RigidBody
 from tumble.rigid.forces import State
@@ -36,19 +37,12 @@ class Solution:
     """
 
     def __init__(self, stepper: Any, ts: Sequence[float], interpolants: Sequence[Callable]):
-        self.stepper, self.ts = stepper, np.asarray(ts, dtype=float)
-        self.interpolants = list(interpolants)
+        self.stepper, self.dense = stepper, DenseOutput(ts, interpolants)
 
     def __call__(self, t: float | Sequence[float] | np.ndarray) -> State:
-        times = np.asarray(t, dtype=float)
-        if np.any(times < self.ts[0]) or np.any(times > self.ts[-1]):
-            raise ValueError(
-                f"t={t!r} is not allowed: must be within the run, [{self.ts[0]}, {self.ts[-1]}]"
-            )
-        index = np.clip(np.searchsorted(self.ts, times, side="right") - 1, 0,
-                        len(self.interpolants) - 1)  # fmt: skip
+        times, index = self.dense.steps(np.asarray(t, dtype=float))
         states = [
-            self.stepper.public(self.interpolants[int(i)](float(s)))
+            self.stepper.public(self.dense.interpolants[int(i)](float(s)))
             for i, s in zip(np.ravel(index), np.ravel(times), strict=True)
         ]
         if times.ndim == 0:
