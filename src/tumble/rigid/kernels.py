@@ -308,6 +308,19 @@ class Records(NamedTuple):
     Y: np.ndarray
 
 
+def _stages(problem, A, z, Rn, h, first, K, zs, R):
+    """The stages ``first … s−1`` of one step: ``k_i = f(z + h Σ_{j<i} a_ij k_j)`` into ``K``
+    (``zs`` and ``R`` are work arrays; ``first`` = 1 when ``K[0]`` is known, FSAL). ``FIELD``
+    is the chart's compiled field, bound by :func:`_for_chart`; inlined into its loops."""
+    for i in range(first, A.shape[0]):
+        for q in range(z.shape[0]):
+            acc = 0.0
+            for j in range(i):
+                acc += A[i, j] * K[j, q]
+            zs[q] = z[q] + h * acc
+        FIELD(problem, zs, Rn, R, K, i)  # noqa: F821
+
+
 def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
     """Steps ``k0+1 … k1`` of ``grid`` (a :class:`~tumble.ode.driver.Grid`) for one chart.
 
@@ -322,8 +335,8 @@ def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
     Step ``k`` is recorded when ``step0 + k`` is a multiple of ``every``. Returns
     ``(recorded, failed, cause)``: ``failed`` is the step whose result was not finite (the
     state is left at the step before), or -1; ``cause`` is :data:`NON_FINITE` then.
-    ``FIELD``, ``ADVANCE`` and ``RECORD`` are the chart's compiled functions, bound by
-    :func:`_for_chart`.
+    ``STAGES`` (:func:`_stages` with the chart's field), ``ADVANCE`` and ``RECORD`` are the
+    chart's compiled functions, bound by :func:`_for_chart`.
     """
     A, b = problem.A, problem.b
     t_a, t_b, h, n = grid
@@ -334,13 +347,7 @@ def _loop(problem, grid, z, Rn, k0, k1, every, step0, records):
         t_old = t_a + (k - 1) * h
         hk = (t_b if k == n else t_a + k * h) - t_old
         START(z, Rn)  # noqa: F821
-        for i in range(s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
-            for q in range(nz):
-                acc = 0.0
-                for j in range(i):
-                    acc += A[i, j] * K[j, q]
-                zs[q] = z[q] + hk * acc
-            FIELD(problem, zs, Rn, R, K, i)  # noqa: F821
+        STAGES(problem, A, z, Rn, hk, 0, K, zs, R)  # noqa: F821
         finite = True
         for q in range(nz):  # z_new = z + h Σ b_i k_i
             acc = 0.0
@@ -411,13 +418,7 @@ def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, fsal, z, Rn, every
         t_new = min(t + planned, t1)
         hk = t_new - t
         START(z, Rn)  # noqa: F821
-        for i in range(1 if have_first else 0, s):  # k_i = f(z + h Σ_{j<i} a_ij k_j)
-            for q in range(nz):
-                acc = 0.0
-                for j in range(i):
-                    acc += A[i, j] * K[j, q]
-                zs[q] = z[q] + hk * acc
-            FIELD(problem, zs, Rn, R, K, i)  # noqa: F821
+        STAGES(problem, A, z, Rn, hk, 1 if have_first else 0, K, zs, R)  # noqa: F821
         for q in range(nz):  # z_new = z + h Σ b_i k_i, error h Σ e_i k_i
             acc, acc_e = 0.0, 0.0
             for i in range(s):
@@ -485,7 +486,8 @@ _ERROR_NORM = njit(**_INLINE)(charts.error_norm)
 def _for_chart(
     name: str, field, advance, record, start=_no_start, fsal=_no_first_same_as_last
 ) -> CompiledChart:
-    chart = dict(FIELD=field, ADVANCE=advance, RECORD=record, START=start)
+    stages = njit(**_INLINE)(_bind(_stages, f"_stages_{name}", FIELD=field))
+    chart = dict(STAGES=stages, ADVANCE=advance, RECORD=record, START=start)
     loop = njit(**_JIT)(_bind(_loop, f"_loop_{name}", **chart))
     batch = njit(parallel=True, **_JIT)(_bind(_batch, f"_batch_{name}", LOOP=loop))
     adaptive = njit(**_JIT)(
