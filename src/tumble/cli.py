@@ -390,8 +390,9 @@ def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool)
                 _mode_cell(radius[k], v[k])
                 for radius, v in zip(table.spectral_radius, values, strict=True)
             ]
-            omega = f"{w:.0f}" if w >= 100 else f"{w:.4g}"  # no exponent: the column stays narrow
-            grid.add_row(str(k + 1), omega, f"{w * step:.3g}", *cells)
+            # ω without an exponent, so the column stays narrow
+            frequency = f"{w:.0f}" if w >= 100 else f"{w:.4g}"
+            grid.add_row(str(k + 1), frequency, f"{w * step:.3g}", *cells)
         console.print(grid)
     console.print(f"plots: {path}, {folder / 'schemes_vs_exact.png'}", highlight=False)
 

@@ -305,15 +305,14 @@ def _peer_energy(problem: Problem, omega: np.ndarray, R: np.ndarray) -> np.ndarr
     return kinetic - np.einsum("nij,j,i->n", R, problem.dipole.moment, problem.dipole.field)
 
 
-def _scipy_run(method: str, problem: Problem, rtol: float, t_end: float,
-               atol: float | None = None) -> Sampled:  # fmt: skip
+def _scipy_run(method: str, problem: Problem, rtol: float, t_end: float) -> Sampled:
     """solve_ivp on :func:`_rhs`; its samples are its accepted steps."""
     from scipy.integrate import solve_ivp
 
     y0 = np.concatenate([problem.omega0, [1.0, 0.0, 0.0, 0.0]])
     start = time.perf_counter()
     solution = solve_ivp(_rhs(problem), (0.0, t_end), y0, method=method, rtol=rtol,
-                         atol=rtol if atol is None else atol)  # fmt: skip
+                         atol=rtol)  # fmt: skip
     seconds = time.perf_counter() - start
     y = solution.y.T
     q = y[:, 3:]
@@ -396,7 +395,7 @@ def reference(problem: Problem, t_end: float | None = None) -> np.ndarray:
     t_end = problem.t_end if t_end is None else t_end
     if not problem.forced:
         return exact.free_body_rotation(problem.body.inertia, problem.omega0, t_end)
-    return _scipy_run("DOP853", problem, 1e-13, t_end, atol=1e-13).R_end
+    return _scipy_run("DOP853", problem, 1e-13, t_end).R_end
 
 
 def attitude_error(R: np.ndarray, R_ref: np.ndarray) -> float:
@@ -600,11 +599,9 @@ def invariants(row: Row, problem: Problem, t_end: float) -> Invariants | None:
     if run is None:
         return None
     slope, largest, law = growth_law(run.t, run.energy)
-    if not run.ok:  # stopped before T (non-finite, or MuJoCo's reset of an unstable body)
-        law = "failed"
     casimir_slope, casimir, casimir_law = growth_law(run.t, run.casimir)
-    if not run.ok:
-        casimir_law = "failed"
+    if not run.ok:  # stopped before T (non-finite, or MuJoCo's reset of an unstable body)
+        law = casimir_law = "failed"
     return Invariants(problem.name, t_end, slope, largest, law, casimir_slope, casimir,
                       casimir_law, run.orthogonality, run.quaternion, run.steps)  # fmt: skip
 

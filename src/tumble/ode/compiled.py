@@ -10,14 +10,15 @@ every tableau of :data:`~tumble.ode.tableaux.TABLEAUX`):
 * each step is :func:`tumble.ode.stepper.rk_step`
   (:math:`k_i = f(t + c_i h, y + h \\sum_{j<i} a_{ij} k_j)`, :math:`y_{n+1} = y + h \\sum_i
   b_i k_i`, error :math:`h \\sum_i (b_i - \\hat b_i) k_i`);
-* the error norm is :func:`tumble.ode.control.error_norm`'s formula, and the controller's
+* the error norm is :func:`tumble.ode.control.error_norm`'s formula written as a scalar loop
+  (the NumPy one would allocate every step), and the controller's
   factor and the minimum step are :func:`tumble.ode.control.step_factor` and
   :func:`tumble.ode.control.minimum_step` compiled from those very functions (as the rigid
   kernels do), so the loop and the driver cannot drift apart;
 * fixed steps land on :func:`tumble.ode.control.grid_time` (compiled from it);
 * with dense output or events each accepted step records its interpolant's coefficients
-  ``Q`` (:func:`tumble.ode.dense.step_coefficients`, compiled: the tableau's own extension
-  with its extra stages, or the cubic Hermite one), and the result's
+  ``Q`` (:func:`tumble.ode.dense.step_coefficients`' formulas as scalar loops: the tableau's
+  own extension with its extra stages, or the cubic Hermite one), and the result's
   :class:`~tumble.ode.dense.DenseOutput` is built from them;
 * events are located in Python, after each compiled block, by the same
   :class:`~tumble.ode.events.EventTracker` on those interpolants (the events may be compiled
@@ -60,6 +61,7 @@ from tumble.ode.driver import (
     Status,
     _minimum_step_message,
     check_record_size,
+    max_steps_message,
     non_finite_message,
 )
 from tumble.ode.events import Event, EventTracker
@@ -95,7 +97,7 @@ class Tableau:
     def __init__(self, tableau: ButcherTableau):
         s, m = tableau.stages, tableau.extra_stages
         dense = tableau.dense
-        self.fsal, self.hermite = tableau.fsal, dense is None
+        self.hermite = dense is None
         self.q = 3 if dense is None else dense.shape[1]
         P = np.zeros((s + 1 + m, self.q))
         if dense is not None:
@@ -377,7 +379,7 @@ def march(
             message = _minimum_step_message(t, control.minimum_step(t), finite)
         elif code == MAX_STEPS:
             status = Status.FAILED
-            message = f"max_steps={max_steps} reached at t={t!r}; increase `max_steps`"
+            message = max_steps_message(max_steps, t)
         if code != GOING or t >= t1:
             break
         size = size if events else min(2 * size, LARGEST_BLOCK)

@@ -139,6 +139,11 @@ _MESSAGES = {
 }
 
 
+def max_steps_message(max_steps: float, t: float) -> str:
+    """The message of a run stopped by ``max_steps`` (the one wording everywhere)."""
+    return f"max_steps={max_steps} reached at t={t!r}; increase `max_steps`"
+
+
 def non_finite_message(t_old: float, t_new: float) -> str:
     """The message of a run stopped by a non-finite state (the one wording everywhere)."""
     return (
@@ -371,7 +376,7 @@ class _Run:
         self.status, self.message = Status.FAILED, message
 
     def max_steps_message(self) -> str:
-        return f"max_steps={self.max_steps} reached at t={self.t!r}; increase `max_steps`"
+        return max_steps_message(self.max_steps, self.t)
 
     def record(self) -> None:
         """Sample the current state (replacing a sample at the same time: before a jump)."""

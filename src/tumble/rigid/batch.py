@@ -336,7 +336,7 @@ def _kernel_loads(forces, bodies):
     return (F, *compiled_loads(loads, bodies[0].mass)[1:])
 
 
-def _record_times(grid: Grid, every: int) -> np.ndarray:
+def record_times(grid: Grid, every: int) -> np.ndarray:
     """The kernel's sample times ``t_old + h_k`` at steps ``every, 2 every, …`` (exactly)."""
     k = np.arange(every, grid.n + 1, every)
     t_old = grid.t0 + (k - 1) * grid.h
@@ -529,7 +529,7 @@ class BatchStepper(Stepper):
                        self.causes)  # fmt: skip
         q = records.q if self._quat else np.empty((n_bodies, size, 0))
         return Block(
-            t=_record_times(grid, every),
+            t=record_times(grid, every),
             records=(records.R, records.Y, q),
             state=(RN, Z) if self.split else self.chart.read(Z, RN),
         )

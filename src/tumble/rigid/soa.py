@@ -43,7 +43,6 @@ from tumble.rigid.kernels import (
     _S4,
     _S5,
     _SERIES2,
-    NON_FINITE,
     _dexpinv_coefficient,
     _exp_coefficients,
     _quat_matrix,
@@ -323,7 +322,3 @@ def run_batch(quat, problem, grid, Z, RN, inv_I, m, F, every, records, counts, f
                records, counts, failed)  # fmt: skip
         Z[:, j0:j1] = z
         RN[:, j0:j1] = Rn
-
-
-CAUSE = NON_FINITE
-"""Why a body of :func:`run_batch` stops: its state was not finite."""

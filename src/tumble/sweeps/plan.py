@@ -151,7 +151,7 @@ def shared_time(options: dict, paths: Sequence[tuple], values: Sequence[list]):
     """
     from tumble.ode.control import fixed_step_count
     from tumble.ode.driver import Grid
-    from tumble.rigid.batch import _record_times
+    from tumble.rigid.batch import record_times
     from tumble.rigid.methods import get_method
 
     methods = {options.get("method", "rkmk4")}
@@ -165,7 +165,7 @@ def shared_time(options: dict, paths: Sequence[tuple], values: Sequence[list]):
     h, t_end = options.get("h", 0.01), options.get("t_end", 10.0)
     every = options.get("record_every", 1)
     grid = Grid(0.0, t_end, h, fixed_step_count(0.0, t_end, h))
-    times = np.concatenate([[0.0], _record_times(grid, every)])
+    times = np.concatenate([[0.0], record_times(grid, every)])
     if times[-1] != grid.time(grid.n):
         times = np.append(times, grid.time(grid.n))
     return times
