@@ -80,6 +80,7 @@ import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import IntEnum
+from functools import cache
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -222,7 +223,7 @@ class Stepper:
 
     def finite(self, state: Any) -> bool:
         parts = state if isinstance(state, tuple) else (state,)
-        return all(bool(np.all(np.isfinite(part))) for part in parts)
+        return all(bool(np.isfinite(part).all()) for part in parts)
 
     def scale(self, state: Any) -> np.ndarray:
         return np.abs(state)
@@ -582,8 +583,7 @@ def check_record_size(
         Naming ``h``, the number of samples, the memory they need and what allows; the remedy
         is ``record_every``, a larger ``h`` or a shorter run.
     """
-    with np.errstate(over="ignore"):
-        steps = min(span / h, max_steps)
+    steps = min(float(span) / float(h), max_steps)  # Python floats: inf, no warning
     samples = steps / every + 1 + n_jumps
     per_sample = 8 + sum(np.asarray(part).nbytes for part in sample)
     need, allowed = samples * per_sample, RECORD_MEMORY_SHARE * _memory()
@@ -603,6 +603,7 @@ def check_record_size(
     )
 
 
+@cache
 def _memory() -> float:
     """This machine's physical memory in bytes (16 GiB if the system does not say)."""
     try:

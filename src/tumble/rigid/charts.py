@@ -192,6 +192,13 @@ def _frames(shape: tuple[int, ...]) -> np.ndarray:
     return np.broadcast_to(np.eye(3), (*shape, 3, 3)).copy()
 
 
+def _lie_pack(R: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``z = (u = 0, Y)`` in the chart at ``R``, and ``R`` as the base point."""
+    z = np.zeros((*np.shape(Y)[:-1], 3 + np.shape(Y)[-1]))
+    z[..., 3:] = Y
+    return z, np.array(R, dtype=float)
+
+
 # pack and read take one state or a stack of them (leading axes: simulate_batch's bodies),
 # hence the ``...`` indexing; advance is the Python reference's, one state at a time.
 MATRIX = Chart(
@@ -227,10 +234,7 @@ LIE = Chart(
     size=3,
     attitude=_identity,
     matrix=_identity,
-    pack=lambda R, Y: (
-        np.concatenate([np.zeros((*np.shape(Y)[:-1], 3)), Y], axis=-1),
-        np.array(R, dtype=float),
-    ),
+    pack=_lie_pack,
     advance=lambda z, Rn: (Rn @ so3.exp(z[:3]), z[3:].copy()),
     read=lambda z, Rn: (Rn.copy(), z[..., 3:].copy()),
     field=_lie_field,

@@ -296,6 +296,8 @@ def compiled_loads(loads, mass: float):
         Constant force on the centre of mass (3,), constant torque (3,), body points (k, 3)
         and the constant world forces acting there (k, 3).
     """
+    if not loads:
+        return _NO_LOADS
     if not all(load.compiled for load in loads):
         return None
     F, tau, points, point_forces = np.zeros(3), np.zeros(3), [], []
@@ -315,3 +317,8 @@ def compiled_loads(loads, mass: float):
             point_forces.append(load.force)
     shape = (len(points), 3)
     return F, tau, np.array(points).reshape(shape), np.array(point_forces).reshape(shape)
+
+
+_NO_LOADS = (np.zeros(3), np.zeros(3), np.zeros((0, 3)), np.zeros((0, 3)))
+"""A free body's :func:`compiled_loads`, built once (the kernels only read them; writable, so
+that numba types them as every other run's arrays)."""

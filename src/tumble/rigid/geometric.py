@@ -106,12 +106,13 @@ def principal_frame(inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     a fast path that gives what :func:`tumble._elliptic.principal_axes` gives.
     """
     if inertia[0, 1] == inertia[0, 2] == inertia[1, 2] == 0.0:
-        moments = np.diagonal(inertia)
-        order = tuple(int(k) for k in np.argsort(moments, kind="stable"))
-        axes = np.eye(3)[:, order]
+        diagonal = inertia.diagonal().tolist()
+        order = tuple(sorted(range(3), key=diagonal.__getitem__))  # stable, as argsort's
+        axes = np.zeros((3, 3))
+        axes[order, (0, 1, 2)] = 1.0  # column j is the axis order[j]
         if order not in _EVEN:
             axes[:, 0] = -axes[:, 0]
-        return moments[list(order)], axes
+        return np.array([diagonal[k] for k in order]), axes
     return principal_axes(inertia)
 
 

@@ -48,6 +48,8 @@ def _first_step(t_span: float, Y: np.ndarray, body: RigidBody, rtol: float) -> f
 
 def _jumps(stepper: BodyStepper, impulses, t0: float, t_end: float) -> list[Jump]:
     """The impulses as the driver's jumps, one per distinct time in ``[t0, t_end]``."""
+    if not impulses:
+        return []
     times = sorted({imp.time for imp in impulses if t0 <= imp.time <= t_end})
     return [(time, stepper.kick([imp for imp in impulses if imp.time == time])) for time in times]
 
@@ -56,7 +58,7 @@ def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> Prob
     """The kernels' :class:`~tumble.rigid.kernels.Problem` for ``method`` and constant
     ``loads`` (:func:`~tumble.rigid.forces.compiled_loads`); ``axes``, ``moments`` are the
     principal frame (``split`` methods; with a leading body axis in a batch)."""
-    from tumble.rigid.kernels import Problem
+    from tumble.rigid.kernels import Problem  # numba only when a compiled run needs it
 
     if method.tableau is None:
         A, b = np.zeros((0, 0)), np.array(method.weights)
@@ -101,11 +103,15 @@ def stepper_for(method: Method, body: RigidBody, loads, kernel_loads) -> BodySte
         )  # fmt: skip
     if kernel_loads is None:
         return RigidStepper(method, dynamics)
-    eye = np.eye(3)
     return CompiledStepper(
         method, dynamics,
-        problem(method, body.inertia_inverse, body.mass, kernel_loads, eye, np.ones(3)),
+        problem(method, body.inertia_inverse, body.mass, kernel_loads, *_NO_PRINCIPAL_FRAME),
     )  # fmt: skip
+
+
+_NO_PRINCIPAL_FRAME = (np.eye(3), np.ones(3))
+"""The kernels' ``axes`` and ``moments`` for the charts that do not use them (never written:
+built once, not at every call)."""
 
 
 def simulate(
@@ -309,8 +315,10 @@ def simulate(
     sol = None
     if out.step_times is not None and out.interpolants is not None:
         sol = Solution(stepper, out.step_times, out.interpolants)
-    with np.errstate(over="ignore", invalid="ignore"):
-        V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
+    V = None  # no load with a potential: the Trajectory's zeros
+    if any(load.conservative for load in loads):
+        with np.errstate(over="ignore", invalid="ignore"):
+            V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
     return Trajectory(
         t=out.t,
         x=Y_samples[:, :3],
