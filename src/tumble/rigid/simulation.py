@@ -315,7 +315,7 @@ def simulate(
     sol = None
     if out.step_times is not None and out.interpolants is not None:
         sol = Solution(stepper, out.step_times, out.interpolants)
-    V = None  # no load with a potential: the Trajectory's zeros
+    V = np.zeros(len(out.t))
     if any(load.conservative for load in loads):
         with np.errstate(over="ignore", invalid="ignore"):
             V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
