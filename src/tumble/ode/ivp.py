@@ -80,6 +80,9 @@ class RungeKutta(Stepper):
     (:func:`~tumble.ode.dense.step_coefficients`).
     """
 
+    compiled_evaluations = 0
+    """Evaluations of ``fun`` made in compiled code, unseen by a Python counter."""
+
     def __init__(self, fun: Callable, tableau: ButcherTableau, t0: float, y0: np.ndarray):
         self.fun, self.tableau = fun, tableau
         self.adaptive, self.error_order = tableau.adaptive, tableau.error_order
@@ -107,31 +110,18 @@ def is_compiled(fun: object) -> bool:
     return kind.__name__ == "CPUDispatcher" and kind.__module__.startswith("numba")
 
 
-def _solve_compiled(
-    counted: _CountedFunction, tableau: ButcherTableau, t_span: tuple[float, float],
-    y: np.ndarray, h: float | None, rtol: float, atol: np.ndarray, events: list,
-    dense_output: bool, max_steps: int,
-) -> OdeResult:  # fmt: skip
-    """:func:`solve` with a compiled ``fun``: ``f(t0, y0)`` (its shape checked), then the
-    loop of :func:`tumble.ode.compiled.march` (which chooses the first step if need be)."""
-    from tumble.ode import compiled  # imports numba: only for a compiled fun
+def _stepper(
+    counted: _CountedFunction, tableau: ButcherTableau, t0: float, y: np.ndarray,
+    interpolants: bool,
+) -> RungeKutta:  # fmt: skip
+    """:func:`solve`'s stepper: :class:`RungeKutta`, or its compiled twin
+    (:class:`tumble.ode.compiled.CompiledRungeKutta`) for a compiled ``fun``; each evaluates
+    ``f(t0, y0)`` through ``counted``, which checks its shape."""
+    if not is_compiled(counted.fun):
+        return RungeKutta(counted, tableau, t0, y)
+    from tumble.ode.compiled import CompiledRungeKutta  # imports numba: only for a compiled fun
 
-    f0 = counted(t_span[0], y)
-    out = compiled.march(counted.fun, tableau, t_span, y, f0, h=h, nfev=counted.count,
-                         rtol=rtol, atol=atol, events=events, dense_output=dense_output,
-                         max_steps=max_steps)  # fmt: skip
-    return OdeResult(
-        t=out.t,
-        y=out.y.T,
-        t_events=[np.array(ts, dtype=float) for ts in out.t_events],
-        y_events=[np.array(ys, dtype=float).reshape(-1, y.size) for ys in out.y_events],
-        nfev=out.nfev,
-        n_steps=out.n_steps,
-        n_rejected=out.n_rejected,
-        status=out.status,
-        message=out.message,
-        sol=out.sol,
-    )
+    return CompiledRungeKutta(counted, counted.fun, tableau, t0, y, interpolants=interpolants)
 
 
 def _lookup(method: str) -> ButcherTableau:
@@ -195,8 +185,9 @@ def solve(
     ----------
     fun : callable
         Right-hand side ``fun(t, y) -> ndarray, shape (n,)``. A numba-compiled one
-        (``@numba.njit``, returning a float array) makes the whole run compiled
-        (:mod:`tumble.ode.compiled`), with the same result to round-off.
+        (``@numba.njit``, returning a float array) makes the steps compiled
+        (:mod:`tumble.ode.compiled`: the driver marches them in blocks, events and dense
+        output included), with the same result to round-off.
     t_span : (float, float)
         ``(t0, t1)`` with ``t1 > t0``. The last step lands exactly on ``t1``.
     y0 : array_like, shape (n,)
@@ -258,14 +249,11 @@ def solve(
     events = _checks.callables("events", events)
     dense_output = _checks.flag("dense_output", dense_output)
     counted = _CountedFunction(fun, y.size)
-    if is_compiled(fun):
-        return _solve_compiled(counted, tableau, (t0, t1), y, h, float(rtol), atol_array,
-                               events or [], dense_output, int(max_steps))  # fmt: skip
-    stepper = RungeKutta(counted, tableau, t0, y)
+    stepper = _stepper(counted, tableau, t0, y, bool(events) or dense_output)
     control = None
     if tableau.adaptive:
         control = Control(float(rtol), atol_array)
-        if h is None:
+        if h is None and not stepper.adaptive_blocks:  # else the compiled loop chooses it
             h = initial_step(counted, t0, y, stepper.f, tableau.error_order, rtol, atol_array)
     # Non-finite values are detected and reported as a status, not as numpy warnings.
     with np.errstate(over="ignore", invalid="ignore"):
@@ -281,7 +269,7 @@ def solve(
         y=out.records[0].T,
         t_events=t_events,
         y_events=y_events,
-        nfev=counted.count,
+        nfev=counted.count + stepper.compiled_evaluations,
         n_steps=out.n_steps,
         n_rejected=out.n_rejected,
         status=out.status,
