@@ -722,6 +722,8 @@ def _bytes(count: float) -> str:
 
 def _segments(t0: float, t1: float, jumps: Sequence[Jump]) -> list[tuple[float, list]]:
     """``[(end, jumps applied at the end), ...]``: the span cut at the jumps' times."""
+    if not jumps:
+        return [(t1, [])]
     times = sorted({time for time, _ in jumps if t0 <= time <= t1} | {t1})
     return [(b, [apply for time, apply in jumps if time == b]) for b in times]
 

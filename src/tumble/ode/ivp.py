@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tumble import _checks
-from tumble.ode.control import initial_step, relative_tolerance
+from tumble.ode.control import StepController, initial_step, relative_tolerance
 from tumble.ode.dense import DenseOutput, StepInterpolant, step_coefficients
 from tumble.ode.driver import Control, Status, Stepper, march
 from tumble.ode.events import Event
@@ -119,9 +119,20 @@ def _stepper(
     ``f(t0, y0)`` through ``counted``, which checks its shape."""
     if not is_compiled(counted.fun):
         return RungeKutta(counted, tableau, t0, y)
-    from tumble.ode.compiled import CompiledRungeKutta  # imports numba: only for a compiled fun
+    if not _COMPILED:
+        from tumble.ode.compiled import CompiledRungeKutta  # imports numba: only now
 
-    return CompiledRungeKutta(counted, counted.fun, tableau, t0, y, interpolants=interpolants)
+        _COMPILED.append(CompiledRungeKutta)
+    return _COMPILED[0](counted, counted.fun, tableau, t0, y, interpolants=interpolants)
+
+
+_COMPILED: list[type[RungeKutta]] = []
+""":class:`tumble.ode.compiled.CompiledRungeKutta` once imported (a second import statement
+costs a few µs of a short run)."""
+
+
+_CONTROLLER = StepController()
+""":func:`solve`'s step controller (the defaults: one instance for every run)."""
 
 
 def _lookup(method: str) -> ButcherTableau:
@@ -158,8 +169,10 @@ def _check_step(h, tableau: ButcherTableau) -> float | None:
     return _checks.positive("h", h)
 
 
-def _check_tolerances(rtol, atol, n: int) -> np.ndarray:
+def _check_tolerances(rtol, atol, n: int) -> np.ndarray | float:
     relative_tolerance(rtol)
+    if isinstance(atol, float | int) and not isinstance(atol, bool) and atol >= 0:
+        return _checks.non_negative("atol", atol)  # a number: no array to check
     atol_array = _checks.array("atol", atol)
     if atol_array.shape not in ((), (n,)) or np.any(atol_array < 0):
         raise _checks.fail("atol", atol, f">= 0 and finite, a scalar or of shape ({n},)")
@@ -252,7 +265,7 @@ def solve(
     stepper = _stepper(counted, tableau, t0, y, bool(events) or dense_output)
     control = None
     if tableau.adaptive:
-        control = Control(float(rtol), atol_array)
+        control = Control(float(rtol), atol_array, _CONTROLLER)
         if h is None and not stepper.adaptive_blocks:  # else the compiled loop chooses it
             h = initial_step(counted, t0, y, stepper.f, tableau.error_order, rtol, atol_array)
     # Non-finite values are detected and reported as a status, not as numpy warnings.
