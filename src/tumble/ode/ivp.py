@@ -126,7 +126,7 @@ def _stepper(
     return _COMPILED[0](counted, counted.fun, tableau, t0, y, interpolants=interpolants)
 
 
-_COMPILED: list[type[RungeKutta]] = []
+_COMPILED: list[Callable[..., RungeKutta]] = []
 """:class:`tumble.ode.compiled.CompiledRungeKutta` once imported (a second import statement
 costs a few µs of a short run)."""
 
