@@ -404,8 +404,8 @@ class CompiledRungeKutta(RungeKutta):
     def _settings(self, control: Control, n: int) -> tuple:
         """``atol`` as an (n,) array and the controller's settings, kept for the run."""
         if self._control[0] is not control:
-            atol = np.array(control.atol, dtype=float)
-            atol = np.full(n, float(atol)) if atol.ndim == 0 else atol
+            atol = np.array(control.atol, dtype=float)  # a number, or shape () or (n,)
+            atol = np.full(n, atol) if atol.ndim == 0 else atol
             rule = control.controller
             settings = (float(rule.safety), float(rule.min_factor), float(rule.max_factor),
                         int(self.error_order), float(control.horizon or 0.0))  # fmt: skip

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -146,7 +147,7 @@ def _check_span(t_span) -> tuple[float, float]:
         t0, t1 = (float(t) for t in t_span)
     except (TypeError, ValueError):
         raise _checks.fail("t_span", t_span, allowed, remedy=remedy) from None
-    if not (np.isfinite(t0) and np.isfinite(t1)) or t1 <= t0:
+    if not (math.isfinite(t0) and math.isfinite(t1)) or t1 <= t0:
         raise _checks.fail("t_span", t_span, allowed, remedy=remedy)
     return t0, t1
 
