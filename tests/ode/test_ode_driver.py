@@ -285,3 +285,8 @@ def test_the_suggested_record_every_makes_the_run_fit(monkeypatch):
     assert run.status == 0 and run.t[-1] == 10.0
     with pytest.raises(ValueError, match="record_every >= "):
         tumble.simulate(body, 10.0, h=1e-3, omega0=[1, 0, 0], record_every=every // 2)
+
+
+def test_only_a_stepper_with_compiled_adaptive_blocks_may_be_left_to_choose_the_first_step():
+    with pytest.raises(TypeError, match="march needs h"):
+        march(Controlled(), (0.0, 1.0), np.array([1.0]), h=None, control=Control(1e-6, 1e-9))
