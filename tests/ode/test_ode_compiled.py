@@ -14,6 +14,7 @@ import pytest
 
 from tumble import solve
 from tumble.ode import TABLEAUX
+from tumble.ode.ivp import RungeKutta
 
 MU = 2.0
 ADAPTIVE_BOUND = 1e-8
@@ -116,3 +117,23 @@ def test_compiled_run_stops_after_max_steps_as_the_python_path(method):
     assert runs[0].status == -1 and runs[0].n_steps == runs[1].n_steps == 7
     assert runs[0].message.split(" at t=")[0] == runs[1].message.split(" at t=")[0]
     assert "max_steps=7 reached" in runs[0].message
+
+
+def _python_steps_forbidden(monkeypatch):
+    """Make every per-step Python method of solve's stepper raise."""
+
+    def forbidden(*args):
+        raise AssertionError("a step was taken in Python")
+
+    for name in ("step", "accept", "interpolant"):
+        monkeypatch.setattr(RungeKutta, name, forbidden)
+
+
+@pytest.mark.parametrize("method", TABLEAUX)
+def test_compiled_solve_takes_no_step_in_python_with_events_and_dense_output(method, monkeypatch):
+    options, _ = _options(method)
+    _python_steps_forbidden(monkeypatch)
+    with pytest.raises(AssertionError, match="in Python"):  # the Python path steps there
+        solve(van_der_pol_python, (0, 1), [2, 0], **options)
+    run = solve(van_der_pol, (0, 8), [2, 0], events=position, dense_output=True, **options)
+    assert run.status == 0 and len(run.t_events[0]) == 2 and run.sol is not None

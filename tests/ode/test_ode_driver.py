@@ -6,7 +6,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from tumble.ode.control import fixed_step_count
-from tumble.ode.driver import Block, Control, Grid, Status, Stepper, march
+from tumble.ode.driver import EVENT_BLOCK, Block, Control, Grid, Status, Stepper, Steps, march
 
 
 class Decay(Stepper):
@@ -83,6 +83,80 @@ def test_events_and_dense_output_take_the_python_path():
     stepper = BlockDecay()
     out = run(stepper, dense_output=True)
     assert stepper.calls == 0 and len(out.interpolants) == out.n_steps == 4
+
+
+class StepsDecay(BlockDecay):
+    """BlockDecay whose blocks also return their steps and interpolants (Block.steps)."""
+
+    block_interpolants = True
+
+    def __init__(self):
+        super().__init__()
+        self.steps, self.rewound = 0, None
+
+    def march_block(self, y, grid, k0, k1, every, step0):
+        times = [grid.time(k) for k in range(k0, k1 + 1)]
+        states = [y]
+        for i in range(k1 - k0):
+            states.append(self.step(times[i], states[-1], times[i + 1] - times[i])[0])
+        self.steps += k1 - k0
+        block = super().march_block(y, grid, k0, k1, every, step0)
+        sols = [
+            self.interpolant(times[i], states[i], times[i + 1], states[i + 1])
+            for i in range(k1 - k0)
+        ]
+        block.steps = Steps(np.array(times[1:]), states[1:], sols)
+        return block
+
+    def rewind(self, block, index):
+        self.rewound = (block.steps.t[index], self.steps - len(block.steps.t) + index + 1)
+
+
+def _crossing(terminal):
+    def below_tenth(t, y):
+        return y[0] - 0.1
+
+    below_tenth.terminal = terminal
+    return below_tenth
+
+
+@pytest.mark.parametrize(
+    "options",
+    [
+        dict(events=[_crossing(False)], record_every=3),
+        dict(events=[_crossing(True)], record_every=3),
+        dict(events=[_crossing(True)], dense_output=True),
+        dict(dense_output=True),
+        dict(t_eval=np.linspace(0.05, 4.0, 33)),
+    ],
+    ids=["event", "terminal-event", "terminal-event-dense", "dense", "t_eval"],
+)
+def test_blocks_with_steps_give_the_python_paths_events_dense_output_and_t_eval(options):
+    python = march(Decay(), (0.0, 5.0), np.array([1.0]), h=1 / 128, **options)
+    stepper = StepsDecay()
+    blocks = march(stepper, (0.0, 5.0), np.array([1.0]), h=1 / 128, **options)
+    assert stepper.calls > 0  # marched in blocks, not in Python
+    assert (blocks.status, blocks.n_steps) == (python.status, python.n_steps)
+    np.testing.assert_array_equal(blocks.t, python.t)
+    np.testing.assert_allclose(blocks.records[0], python.records[0], rtol=1e-15)
+    np.testing.assert_array_equal(blocks.t_events, python.t_events)
+    if python.step_times is not None:
+        np.testing.assert_array_equal(blocks.step_times, python.step_times)
+        middles = (np.array(python.step_times[:-1]) + python.step_times[1:]) / 2
+        for ours, theirs, t in zip(blocks.interpolants, python.interpolants, middles,
+                                   strict=True):  # fmt: skip
+            assert ours(t) == theirs(t)
+
+
+def test_a_terminal_event_in_a_block_ends_the_run_there_with_that_steps_counters():
+    stepper = StepsDecay()
+    out = march(stepper, (0.0, 5.0), np.array([1.0]), h=1 / 128, events=[_crossing(True)])
+    # (1 − 1/128)^k falls below 0.1 in step k = 294: the second block of EVENT_BLOCK steps
+    k = int(np.ceil(np.log(0.1) / np.log(1 - 1 / 128)))
+    assert out.status == Status.TERMINAL_EVENT and out.n_steps == k == 294
+    assert stepper.steps == 2 * EVENT_BLOCK  # the blocks stop at EVENT_BLOCK steps with events
+    assert stepper.rewound == (k / 128, k)
+    assert (k - 1) / 128 < out.t[-1] == out.t_events[0][0] < k / 128
 
 
 @pytest.mark.parametrize("make", [Blowup, lambda: type("B", (BlockDecay, Blowup), {})()])
@@ -211,3 +285,8 @@ def test_the_suggested_record_every_makes_the_run_fit(monkeypatch):
     assert run.status == 0 and run.t[-1] == 10.0
     with pytest.raises(ValueError, match="record_every >= "):
         tumble.simulate(body, 10.0, h=1e-3, omega0=[1, 0, 0], record_every=every // 2)
+
+
+def test_only_a_stepper_with_compiled_adaptive_blocks_may_be_left_to_choose_the_first_step():
+    with pytest.raises(TypeError, match="march needs h"):
+        march(Controlled(), (0.0, 1.0), np.array([1.0]), h=None, control=Control(1e-6, 1e-9))

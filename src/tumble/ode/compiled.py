@@ -1,40 +1,42 @@
-"""``solve``'s compiled path: the whole integration in numba when ``fun`` is compiled.
+"""``solve``'s compiled stepper: its Runge–Kutta steps in numba when ``fun`` is compiled.
 
 When the right-hand side handed to :func:`tumble.solve` is a numba-compiled function (a
-``CPUDispatcher``, made by ``@numba.njit``), the step loop runs compiled with ``fun`` called
-from compiled code: no Python per step. It is the loop of :func:`tumble.ode.driver.march`
-with the stepper :class:`tumble.ode.ivp.RungeKutta`, written once more for numba, and must
-give the same result to round-off (``tests/ode/test_ode_compiled.py`` compares the two for
-every tableau of :data:`~tumble.ode.tableaux.TABLEAUX`):
+``CPUDispatcher``, made by ``@numba.njit``), the stepper :func:`tumble.ode.driver.march` runs
+is :class:`CompiledRungeKutta`: :class:`tumble.ode.ivp.RungeKutta` whose fixed grids
+(``march_block``, :func:`_fixed_loop`) and adaptive steps (``march_adaptive``,
+:func:`_adaptive_loop`) run in numba loops that call ``fun`` from compiled code, with no
+Python per step. Everything around the steps is the driver's, as for every stepper: the
+record, the status and its message, ``max_steps``, events, dense output. The loops are the
+Python stepper's algorithm and must give its result to round-off
+(``tests/ode/test_ode_compiled.py`` compares the two for every tableau of
+:data:`~tumble.ode.tableaux.TABLEAUX`):
 
 * each step is :func:`tumble.ode.stepper.rk_step`
   (:math:`k_i = f(t + c_i h, y + h \\sum_{j<i} a_{ij} k_j)`, :math:`y_{n+1} = y + h \\sum_i
   b_i k_i`, error :math:`h \\sum_i (b_i - \\hat b_i) k_i`);
 * the error norm is :func:`tumble.ode.control.error_norm`'s formula written as a scalar loop
-  (the NumPy one would allocate every step), and the controller's
-  factor and the minimum step are :func:`tumble.ode.control.step_factor` and
-  :func:`tumble.ode.control.minimum_step` compiled from those very functions (as the rigid
-  kernels do), so the loop and the driver cannot drift apart;
+  (the NumPy one would allocate every step), and the controller's factor, the minimum step
+  and the first step are :func:`tumble.ode.control.step_factor`,
+  :func:`tumble.ode.control.minimum_step` and :func:`tumble.ode.control.initial_step`
+  compiled from those very functions (as the rigid kernels do), so the loop and the driver
+  cannot drift apart;
 * fixed steps land on :func:`tumble.ode.control.grid_time` (compiled from it);
-* with dense output or events each accepted step records its interpolant's coefficients
-  ``Q`` (:func:`tumble.ode.dense.step_coefficients`' formulas as scalar loops: the tableau's
-  own extension with its extra stages, or the cubic Hermite one), and the result's
-  :class:`~tumble.ode.dense.DenseOutput` is built from them;
-* events are located in Python, after each compiled block, by the same
-  :class:`~tumble.ode.events.EventTracker` on those interpolants (the events may be compiled
-  or not). The loop runs in blocks of at most :data:`EVENT_BLOCK` steps when there are
-  events, so a terminal event wastes at most one block of steps beyond it; the result is cut
-  at the event with the counters (``nfev``, ``n_steps``, ``n_rejected``) of that step.
+* with events or dense output (``interpolants=True``) each accepted step also records its
+  interpolant's coefficients ``Q`` (:func:`tumble.ode.dense.step_coefficients`' formulas as
+  scalar loops: the tableau's own extension with its extra stages, or the cubic Hermite
+  one), and each block hands the driver its steps (``Block.steps``,
+  ``block_interpolants``): the driver locates the events on them with its
+  :class:`~tumble.ode.events.EventTracker` (the events may be compiled or not) and keeps
+  them as the dense output.
 
-This is the one step loop beside :func:`tumble.ode.driver.march`: the driver runs compiled
-blocks only without events and dense output, and here both stay compiled.
-
-The loop, :func:`_loop`, takes ``fun`` as an argument, so numba compiles it once per
-right-hand side and process (2 to 5 s here, ``benchmarks/bench_cold.py``): numba keys a
-function that receives another by that function's identity, so such a loop can never come
-from the on-disk cache (``cache=True`` would only add an index entry at each run). What it
-calls is cached. After the first call the loop is called through its compiled entry point
-(about 1 µs instead of numba's 14 µs dispatch of a function argument).
+The loops take ``fun`` as an argument, so numba compiles them once per right-hand side and
+process (2 to 5 s here, ``benchmarks/bench_cold.py``): numba keys a function that receives
+another by that function's identity, so such a loop can never come from the on-disk cache
+(``cache=True`` would only add an index entry at each run). What they call is cached. After
+the first call a loop is called through its compiled entry point (about 1 µs instead of
+numba's 14 µs dispatch of a function argument). The few lines that call ``fun`` (the stages,
+the extension's extra stages) are written in each loop: a compiled helper that receives
+``fun`` calls it indirectly, which made the loops 1.3 to 2.5 times slower.
 
 References
 ----------
@@ -46,8 +48,7 @@ from __future__ import annotations
 
 import math
 import weakref
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable
 from functools import cache
 from typing import Any
 
@@ -56,26 +57,20 @@ import numpy as np
 from numba import njit
 
 from tumble.ode import control
-from tumble.ode.dense import DenseOutput, StepInterpolant
-from tumble.ode.driver import (
-    Status,
-    _minimum_step_message,
-    check_record_size,
-    max_steps_message,
-    non_finite_message,
-)
-from tumble.ode.events import Event, EventTracker
+from tumble.ode.dense import StepInterpolant
+from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Steps
+from tumble.ode.ivp import RungeKutta
 from tumble.ode.tableaux import ButcherTableau
 
-EVENT_BLOCK = 256
-"""With events, the compiled loop returns to Python after at most this many steps."""
-
 FIRST_BLOCK, LARGEST_BLOCK = 256, 1 << 16
-"""An adaptive run's record starts with room for this many steps, doubling up to the second."""
+"""An adaptive block has room for this many steps, doubling at each block up to the second."""
 
-GOING, NON_FINITE, MINIMUM_STEP, MAX_STEPS = 0, 1, 2, 3
-"""How a compiled block ended: at its end or with its record full; a non-finite accepted
-state; a step below the minimum; ``max_steps`` accepted steps."""
+GOING, NON_FINITE, MINIMUM_STEP = 0, 1, 2
+"""How an adaptive block ended: at ``t1``, its record full or ``max_steps`` taken; a
+non-finite accepted state; a step below the minimum."""
+
+FAILURES = {GOING: None, NON_FINITE: "non-finite", MINIMUM_STEP: "minimum-step"}
+"""The codes as :class:`~tumble.ode.driver.AdaptiveBlock` names them."""
 
 _JIT: dict[str, Any] = dict(cache=True, error_model="numpy")
 _INLINE: dict[str, Any] = dict(_JIT, inline="always")
@@ -172,273 +167,254 @@ def _extension(X, P, Q):
             Q[q, col] = acc
 
 
+@njit(**_JIT)
+def _interpolant(tab, hermite, y, y_new, f_new, h, X, Q):
+    """The step's interpolant into ``Q`` (:func:`tumble.ode.dense.step_coefficients`): the
+    cubic Hermite one, or the continuous extension ``Xᵀ P`` from ``X``, the stages followed
+    by ``f_new = fun(t + h, y_new)`` and the extension's extra stages."""
+    if hermite:
+        _hermite(y, y_new, X[0], f_new, h, Q)
+    else:
+        _extension(X, tab[4], Q)
+
+
 @njit(error_model="numpy")
-def _loop(fun, tab, flags, grid, k, t, t1, h, rtol, atol, settings, y, f, steps, max_steps,
-          nfev, rejected, out):  # fmt: skip
-    """Steps of :func:`tumble.solve` from ``(t, y)`` towards ``t1``: the driver's
-    ``_adaptive`` (``flags[0]``) or ``_fixed`` on ``grid = (t0, t1, h, n)`` from its step
-    ``k``.
+def _fixed_loop(fun, tab, hermite, want_q, grid, k0, k1, y, f, nfev, out):
+    """Steps ``k0 + 1 … k1`` of the fixed grid ``(t0, t1, h, n)``: the driver's ``_fixed``
+    with :class:`~tumble.ode.ivp.RungeKutta`.
+
+    ``y`` and ``f`` (``fun`` at ``y``) are updated in place; every accepted step is recorded
+    in ``out = (t, y, Q, nfev)`` (``Q`` when ``want_q``). Returns ``(count, failed, nfev)``:
+    ``failed`` is the grid step whose state was not finite (the block stops before it), or
+    -1; ``nfev`` counts on from the ``nfev`` given.
+    """
+    t0, t1, h, n_grid = grid
+    A, b, c, e, _, dense_A, dense_c = tab
+    ts, ys, Qs, nfevs = out
+    s, n, m = b.shape[0], y.shape[0], dense_c.shape[0]
+    X, z, y_new, err = np.empty((s + 1 + m, n)), np.empty(n), np.empty(n), np.empty(n)
+    for k in range(k0, k1):
+        t = _GRID_TIME(t0, t1, h, k, n_grid)
+        t_new = _GRID_TIME(t0, t1, h, k + 1, n_grid)
+        hk = t_new - t
+        X[0] = f
+        for i in range(1, s):  # k_i = f(t + c_i h, y + h Σ_{j<i} a_ij k_j)
+            _stage_point(A, i, i, y, hk, X, z)
+            X[i, :] = fun(t + c[i] * hk, z)
+        nfev += s - 1
+        if not _combine(b, e, y, hk, X, y_new, err):
+            return k - k0, k + 1, nfev
+        f[:] = fun(t_new, y_new)
+        nfev += 1
+        if want_q:
+            X[s] = f
+            for j in range(m):  # the continuous extension's extra stages
+                _stage_point(dense_A, j, s + 1 + j, y, hk, X, z)
+                X[s + 1 + j, :] = fun(t + dense_c[j] * hk, z)
+            nfev += m
+            _interpolant(tab, hermite, y, y_new, f, hk, X, Qs[k - k0])
+        y[:] = y_new
+        ts[k - k0], ys[k - k0], nfevs[k - k0] = t_new, y_new, nfev
+    return k1 - k0, -1, nfev
+
+
+@njit(error_model="numpy")
+def _adaptive_loop(fun, tab, flags, t, t1, h, rtol, atol, settings, y, f, nfev, max_steps,
+                   out):  # fmt: skip
+    """Adaptive steps from ``(t, y)`` towards ``t1``: the driver's ``_adaptive`` with
+    :class:`~tumble.ode.ivp.RungeKutta`, at most ``max_steps`` accepted ones.
 
     ``h <= 0`` asks for the first step (:func:`tumble.ode.control.initial_step`, compiled
-    from it). ``y`` and ``f`` (``fun`` at ``y``) are updated in place; every accepted step is
-    recorded in ``out = (t, y, Q, nfev, rejected)`` (``Q`` when ``flags[3]``: the step's
-    interpolant, :func:`tumble.ode.dense.step_coefficients`). ``settings`` is ``(safety,
-    min_factor, max_factor, order)``. Returns ``(recorded, t, h_next, k, rejected, code,
-    t_failed, norm_finite, nfev)``: ``code`` is :data:`GOING` (at ``t1`` or the record
-    full), :data:`NON_FINITE` (the step to ``t_failed``), :data:`MINIMUM_STEP`
-    (``norm_finite``: whether its last norm was finite) or :data:`MAX_STEPS`.
+    from it). ``flags = (fsal, hermite, want_q)``; ``settings = (safety, min_factor,
+    max_factor, order, horizon)`` (``horizon`` 0: none, else :meth:`Control.weigh
+    <tumble.ode.driver.Control.weigh>`). ``y`` and ``f`` are updated in place; every accepted
+    step is recorded in ``out = (t, y, Q, nfev, rejected)``. Returns ``(count, t, h_next,
+    rejected, code, t_failed, norm_finite, nfev)``: ``code`` is :data:`GOING` (at ``t1``,
+    the record full or ``max_steps`` taken), :data:`NON_FINITE` (the step to ``t_failed``) or
+    :data:`MINIMUM_STEP` (``norm_finite``: whether its last norm was finite).
     """
-    adaptive, fsal, hermite, want_q = flags
-    A, b, c, e, P, dense_A, dense_c = tab
-    safety, min_factor, max_factor, order = settings
-    t0_grid, t1_grid, h_grid, n_grid = grid
+    fsal, hermite, want_q = flags
+    safety, min_factor, max_factor, order, horizon = settings
     ts, ys, Qs, nfevs, rejects = out
+    A, b, c, e, _, dense_A, dense_c = tab
     s, n, m = b.shape[0], y.shape[0], dense_c.shape[0]
-    if adaptive and h <= 0.0:  # the first step, chosen as solve's Python path does
+    if h <= 0.0:  # the first step, chosen as solve's Python path does
         h = _INITIAL_STEP(fun, t, y, f, order, rtol, atol)
         nfev += 1
-    K, z, y_new, err = np.empty((s, n)), np.empty(n), np.empty(n), np.empty(n)
-    X = np.empty((P.shape[0], n))
-    count, after_rejection = 0, False
-    while count < ts.shape[0] and (t < t1 if adaptive else k < n_grid):
-        if steps + count >= max_steps:
-            return count, t, h, k, rejected, MAX_STEPS, t, True, nfev
-        if adaptive:
-            h_min = _MINIMUM_STEP(t)
-            planned = max(h, h_min)
-            t_new = min(t + planned, t1)
-        else:
-            t = _GRID_TIME(t0_grid, t1_grid, h_grid, k, n_grid)
-            t_new = _GRID_TIME(t0_grid, t1_grid, h_grid, k + 1, n_grid)
+    X, z, y_new, err = np.empty((s + 1 + m, n)), np.empty(n), np.empty(n), np.empty(n)
+    count, rejected, after_rejection = 0, 0, False
+    while t < t1 and count < ts.shape[0] and count < max_steps:
+        h_min = _MINIMUM_STEP(t)
+        planned = max(h, h_min)
+        t_new = min(t + planned, t1)
         hk = t_new - t
-        K[0, :] = f
-        for i in range(1, s):  # k_i = f(t + c_i h, y + h Σ_{j<i} a_ij k_j)
-            _stage_point(A, i, i, y, hk, K, z)
-            K[i, :] = fun(t + c[i] * hk, z)
+        X[0] = f
+        for i in range(1, s):  # the stages, as in _fixed_loop
+            _stage_point(A, i, i, y, hk, X, z)
+            X[i, :] = fun(t + c[i] * hk, z)
+        finite = _combine(b, e, y, hk, X, y_new, err)
         nfev += s - 1
-        finite = _combine(b, e, y, hk, K, y_new, err)
-        if adaptive:
-            norm = _norm(err, y, y_new, rtol, atol)
-            h = hk * _STEP_FACTOR(norm, order, safety, min_factor, max_factor, after_rejection)
-            after_rejection = not norm <= 1.0
-            if after_rejection:
-                rejected += 1
-                if h < h_min:
-                    return count, t, h, k, rejected, MINIMUM_STEP, t_new, math.isfinite(norm), nfev
-                continue
-            if t_new == t1 and t + planned > t1:
-                h = planned  # shortened to land on t1 (as the driver)
+        norm = _norm(err, y, y_new, rtol, atol)
+        if horizon > 0.0:
+            norm *= horizon / hk
+        h = hk * _STEP_FACTOR(norm, order, safety, min_factor, max_factor, after_rejection)
+        after_rejection = not norm <= 1.0
+        if after_rejection:
+            rejected += 1
+            if h < h_min:
+                return count, t, h, rejected, MINIMUM_STEP, t_new, math.isfinite(norm), nfev
+            continue
+        if t_new == t1 and t + planned > t1:
+            h = planned  # shortened to land on t1 (as the driver)
         if not finite:
-            return count, t, h, k, rejected, NON_FINITE, t_new, True, nfev
+            return count, t, h, rejected, NON_FINITE, t_new, True, nfev
         if fsal:  # f at the new point: first same as last, or one evaluation
-            f[:] = K[s - 1]
+            f[:] = X[s - 1]
         else:
             f[:] = fun(t_new, y_new)
             nfev += 1
-        if want_q:
-            if hermite:
-                _hermite(y, y_new, K[0], f, hk, Qs[count])
-            else:
-                X[:s] = K
-                X[s] = f
-                for j in range(m):  # the continuous extension's extra stages
-                    _stage_point(dense_A, j, s + 1 + j, y, hk, X, z)
-                    X[s + 1 + j, :] = fun(t + dense_c[j] * hk, z)
-                nfev += m
-                _extension(X, P, Qs[count])
+        if want_q:  # the interpolant, as in _fixed_loop
+            X[s] = f
+            for j in range(m):
+                _stage_point(dense_A, j, s + 1 + j, y, hk, X, z)
+                X[s + 1 + j, :] = fun(t + dense_c[j] * hk, z)
+            nfev += m
+            _interpolant(tab, hermite, y, y_new, f, hk, X, Qs[count])
         y[:] = y_new
-        t, k = t_new, k + 1
+        t = t_new
         ts[count], ys[count] = t, y
         nfevs[count], rejects[count] = nfev, rejected
         count += 1
-    return count, t, h, k, rejected, GOING, t, True, nfev
+    return count, t, h, rejected, GOING, t, True, nfev
 
 
-_ENTRIES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+_ENTRIES: dict[int, tuple[weakref.ref, dict]] = {}
+"""``id(fun) -> (weak reference to fun, {loop: entry point})`` (a plain dict: a
+``WeakKeyDictionary`` lookup makes a weak reference every call, 0.5 µs of a short run)."""
 
 
 def _call(loop, args: tuple) -> tuple:
     """``loop(*args)`` through its compiled entry point once it is compiled for ``args[0]``.
 
     numba's dispatch of a function argument costs ~14 µs a call (it types the function each
-    time); the entry point of the compiled overload costs ~1 µs.
+    time); the entry point of the compiled overload costs ~1 µs. Every call of a loop passes
+    arguments of the same types, so one overload per loop and ``fun`` is enough.
     """
-    entries = _ENTRIES.setdefault(args[0], {})
-    entry = entries.get(loop)
+    fun = args[0]
+    known = _ENTRIES.get(id(fun))
+    if known is None or known[0]() is not fun:
+        key = id(fun)
+        known = (weakref.ref(fun, lambda _: _ENTRIES.pop(key, None)), {})
+        _ENTRIES[key] = known
+    entry = known[1].get(loop)
     if entry is None:
         result = loop(*args)
-        key = tuple(numba.typeof(a) for a in args)
-        overload = loop.overloads.get(key)
+        overload = loop.overloads.get(tuple(numba.typeof(a) for a in args))
         if overload is not None:
-            entries[loop] = overload.entry_point
+            known[1][loop] = overload.entry_point
         return result
     return entry(*args)
 
 
-@dataclass
-class _Record:
-    """A run's accepted steps, block by block."""
+class CompiledRungeKutta(RungeKutta):
+    """:class:`~tumble.ode.ivp.RungeKutta` whose steps run in numba: the stepper of
+    :func:`tumble.solve` for a compiled ``fun``.
 
-    t: list[np.ndarray]
-    y: list[np.ndarray]
-    Q: list[np.ndarray]
-    nfev: list[np.ndarray]
-    rejected: list[np.ndarray]
-    terminal_h: float | None = None
-    """The full length of the step a terminal event cut (its interpolant spans all of it)."""
-
-
-def _blocks(n: int, q: int, want_q: bool, size: int) -> tuple:
-    Q = np.empty((size if want_q else 0, n, q))
-    return (np.empty(size), np.empty((size, n)), Q, np.empty(size, dtype=np.int64),
-            np.empty(size, dtype=np.int64))  # fmt: skip
-
-
-@dataclass
-class CompiledOutcome:
-    """What :func:`march` returns to :func:`tumble.solve` (the fields of its result)."""
-
-    t: np.ndarray
-    y: np.ndarray
-    t_events: list[list[float]]
-    y_events: list[list[np.ndarray]]
-    nfev: int
-    n_steps: int
-    n_rejected: int
-    status: Status
-    message: str
-    sol: DenseOutput | None
-
-
-def march(
-    fun: Callable,
-    tableau: ButcherTableau,
-    t_span: tuple[float, float],
-    y0: np.ndarray,
-    f0: np.ndarray,
-    *,
-    h: float | None,
-    nfev: int,
-    rtol: float,
-    atol: np.ndarray,
-    events: Sequence[Event],
-    dense_output: bool,
-    max_steps: int,
-) -> CompiledOutcome:
-    """Run :func:`tumble.solve` compiled: ``fun`` a numba function, ``f0 = fun(t0, y0)``.
-
-    ``h`` is the fixed step, or an adaptive run's first step (None: chosen in the compiled
-    loop, as :func:`~tumble.ode.control.initial_step` does); ``nfev`` the evaluations made so
-    far (``f0``). Returns what :func:`tumble.ode.driver.march`
-    would have, for :func:`tumble.solve` to wrap.
+    Parameters
+    ----------
+    fun : callable
+        The right-hand side as Python calls it (``solve`` counts those calls): ``f(t0, y0)``
+        here, and :meth:`step` if a run is ever stepped in Python.
+    compiled : numba dispatcher
+        The same right-hand side, called from the loops.
+    tableau : ButcherTableau
+        The method.
+    t0, y0 : float, ndarray of shape (n,)
+        The initial point.
+    interpolants : bool
+        Whether the blocks return their steps with their interpolants
+        (``block_interpolants``): for events and dense output, which then stay compiled.
     """
-    t0, t1 = t_span
-    tab = _tableau(tableau)
-    n = y0.size
-    want_q = dense_output or bool(events)
-    flags = (tableau.adaptive, bool(tableau.adaptive and tableau.fsal), tab.hermite, want_q)
-    y, f = y0.astype(float, copy=True), np.array(f0, dtype=float)
-    tracker = EventTracker(events, t0, y0) if events else None
-    record = _Record([np.array([t0])], [y0[None].copy()], [], [], [])
-    status, message = Status.SUCCESS, Status.SUCCESS.message
-    steps = rejected = k = 0
-    t = t0
-    atol_n = np.full(n, float(atol)) if np.ndim(atol) == 0 else np.array(atol, dtype=float)
-    settings = (control.SAFETY, control.MIN_FACTOR, control.MAX_FACTOR, tableau.error_order)
-    if tableau.adaptive:
-        h = 0.0 if h is None else h
-        grid = (t0, t1, h, 0)
-        size = EVENT_BLOCK if events else FIRST_BLOCK
-    else:
-        assert h is not None
-        grid = (t0, t1, h, control.fixed_step_count(t0, t1, h))
-        check_record_size(t1 - t0, h, 1, max_steps, (y0,))
-        size = min(grid[3], max_steps) + 1
-        size = min(size, EVENT_BLOCK) if events else size
-    while True:
-        out = _blocks(n, tab.q, want_q, size)
-        count, t, h, k, rejected, code, t_failed, finite, nfev = _call(
-            _loop,
-            (fun, tab.arrays, flags, grid, k, t, t1, h, rtol, atol_n, settings, y, f, steps,
-             max_steps, nfev, rejected, out),
-        )  # fmt: skip
-        t_before = record.t[-1][-1]
-        _keep(record, out, count)
-        if tracker is not None:
-            stop = _locate(tracker, record, count, t_before)
-            if stop is not None:
-                steps += stop
-                nfev, rejected = int(record.nfev[-1][-1]), int(record.rejected[-1][-1])
-                status, message = Status.TERMINAL_EVENT, Status.TERMINAL_EVENT.message
-                break
-        steps += count
-        if code == NON_FINITE:
-            status, message = Status.FAILED, non_finite_message(t, t_failed)
-        elif code == MINIMUM_STEP:
-            status = Status.FAILED
-            message = _minimum_step_message(t, control.minimum_step(t), finite)
-        elif code == MAX_STEPS:
-            status = Status.FAILED
-            message = max_steps_message(max_steps, t)
-        if code != GOING or t >= t1:
-            break
-        size = size if events else min(2 * size, LARGEST_BLOCK)
-    return _outcome(record, tracker, dense_output, nfev, steps, rejected, status, message)
+
+    blocks = True
+
+    def __init__(self, fun: Callable, compiled: Callable, tableau: ButcherTableau, t0: float,
+                 y0: np.ndarray, *, interpolants: bool):  # fmt: skip
+        super().__init__(fun, tableau, t0, y0)
+        self.compiled, self.tab = compiled, _tableau(tableau)
+        self.adaptive_blocks, self.block_interpolants = tableau.adaptive, interpolants
+        self._flags = (tableau.fsal, self.tab.hermite, interpolants)  # _adaptive_loop's
+        self.f = np.array(self.f, dtype=float)  # updated in place by the loops
+        self.size = FIRST_BLOCK
+        self.compiled_evaluations = 0
+        self._nfev: np.ndarray | None = None  # after each step of the last block
+        self._control: tuple = (None, None, None)  # (control, atol, settings)
+
+    def march_block(
+        self, state: np.ndarray, grid: Grid, k0: int, k1: int, every: int, step0: int
+    ) -> Block:
+        y = np.array(state, dtype=float)
+        out = _arrays(k1 - k0, y.size, self.tab.q, self.block_interpolants, adaptive=False)
+        grid_tuple = (float(grid.t0), float(grid.t1), float(grid.h), int(grid.n))
+        count, failed, self.compiled_evaluations = _call(_fixed_loop, (
+            self.compiled, self.tab.arrays, self.tab.hermite, self.block_interpolants,
+            grid_tuple, k0, k1, y, self.f, self.compiled_evaluations, out))  # fmt: skip
+        self._nfev = out[3]
+        every_th = slice((-(step0 + k0) - 1) % every, count, every)
+        steps = self._steps(grid.time(k0), state, out, count)
+        return Block(out[0][every_th], (out[1][every_th],), y, failed, steps)
+
+    def march_adaptive(
+        self, state: np.ndarray, t: float, t1: float, h: float, control: Control, every: int,
+        step0: int, max_steps: float,
+    ) -> AdaptiveBlock:  # fmt: skip
+        y = np.array(state, dtype=float)
+        size = max(1, int(min(self.size, max_steps)))
+        self.size = min(2 * self.size, LARGEST_BLOCK)
+        out = _arrays(size, y.size, self.tab.q, self.block_interpolants, adaptive=True)
+        atol, settings = self._settings(control, y.size)
+        count, t_end, h_next, rejected, code, t_failed, finite, nfev = _call(_adaptive_loop, (
+            self.compiled, self.tab.arrays, self._flags, float(t), float(t1), float(h),
+            float(control.rtol), atol, settings, y, self.f, self.compiled_evaluations,
+            float(max_steps), out))  # fmt: skip
+        self.compiled_evaluations, self._nfev = nfev, out[3]
+        every_th = slice((-step0 - 1) % every, count, every)
+        steps = self._steps(t, state, out, count)
+        return AdaptiveBlock(out[0][every_th], (out[1][every_th],), y, t_end, h_next, count,
+                             rejected, FAILURES[code], t_failed, finite, steps)  # fmt: skip
+
+    def rewind(self, block: Block | AdaptiveBlock, index: int) -> None:
+        """A terminal event in step ``index``: the evaluations counted stop with that step."""
+        assert self._nfev is not None
+        self.compiled_evaluations = int(self._nfev[index])
+
+    def _steps(self, t: float, state: np.ndarray, out: tuple, count: int) -> Steps | None:
+        """The block's steps and their interpolants, with ``block_interpolants``."""
+        if not self.block_interpolants:
+            return None
+        ts, ys, Qs = out[0][:count], out[1][:count], out[2]
+        interpolants = []
+        t_old, y_old = float(t), state
+        for i in range(count):
+            t_new = float(ts[i])
+            interpolants.append(StepInterpolant(t_old, t_new - t_old, y_old, Qs[i]))
+            t_old, y_old = t_new, ys[i]
+        return Steps(ts, ys, interpolants, out[4][:count] if len(out) == 5 else None)
+
+    def _settings(self, control: Control, n: int) -> tuple:
+        """``atol`` as an (n,) array and the controller's settings, kept for the run."""
+        if self._control[0] is not control:
+            atol = np.array(control.atol, dtype=float)  # a number, or shape () or (n,)
+            atol = np.full(n, atol) if atol.ndim == 0 else atol
+            rule = control.controller
+            settings = (float(rule.safety), float(rule.min_factor), float(rule.max_factor),
+                        int(self.error_order), float(control.horizon or 0.0))  # fmt: skip
+            self._control = (control, atol, settings)
+        return self._control[1], self._control[2]
 
 
-def _keep(record: _Record, out: tuple, count: int) -> None:
-    ts, ys, Qs, nfevs, rejects = out
-    record.t.append(ts[:count])
-    record.y.append(ys[:count])
-    record.Q.append(Qs[:count])
-    record.nfev.append(nfevs[:count])
-    record.rejected.append(rejects[:count])
-
-
-def _locate(tracker: EventTracker, record: _Record, count: int, t_old: float) -> int | None:
-    """Events over the block just kept; the steps up to a terminal event (the block then
-    ends there, at the event, with that step's counters), or None."""
-    ts, ys, Qs = record.t[-1], record.y[-1], record.Q[-1]
-    y_old = record.y[-2][-1]
-    for i in range(count):
-        sol = StepInterpolant(t_old, ts[i] - t_old, y_old, Qs[i])
-        t_stop = tracker.update(t_old, float(ts[i]), ys[i], sol)
-        if t_stop is not None:
-            record.terminal_h = float(ts[i]) - t_old
-            record.t[-1] = np.append(ts[:i], t_stop)
-            record.y[-1] = np.vstack([ys[:i], sol(t_stop)[None]])
-            for name in ("Q", "nfev", "rejected"):
-                getattr(record, name)[-1] = getattr(record, name)[-1][: i + 1]
-            return i + 1
-        t_old, y_old = float(ts[i]), ys[i]
-    return None
-
-
-def _outcome(
-    record: _Record, tracker: EventTracker | None, dense_output: bool, nfev: int, steps: int,
-    rejected: int, status: Status, message: str,
-) -> CompiledOutcome:  # fmt: skip
-    t = np.concatenate(record.t)
-    y = np.concatenate(record.y)
-    sol = None
-    if dense_output and len(t) > 1:
-        Q = np.concatenate(record.Q)
-        lengths = np.diff(t)
-        if record.terminal_h is not None:
-            lengths[-1] = record.terminal_h
-        interpolants = [
-            StepInterpolant(float(t[i]), float(lengths[i]), y[i], Q[i]) for i in range(len(Q))
-        ]
-        sol = DenseOutput(t, interpolants)
-    return CompiledOutcome(
-        t=t,
-        y=y,
-        t_events=tracker.t_events if tracker else [],
-        y_events=tracker.y_events if tracker else [],
-        nfev=nfev,
-        n_steps=steps,
-        n_rejected=rejected,
-        status=status,
-        message=message,
-        sol=sol,
-    )
+def _arrays(size: int, n: int, q: int, want_q: bool, *, adaptive: bool) -> tuple:
+    """A block's record: ``(t, y, Q, nfev)``, and the rejections for an adaptive one."""
+    arrays = (np.empty(size), np.empty((size, n)), np.empty((size if want_q else 0, n, q)),
+              np.empty(size, dtype=np.int64))  # fmt: skip
+    return (*arrays, np.empty(size, dtype=np.int64)) if adaptive else arrays

@@ -40,7 +40,19 @@ A stepper is an object with (see :class:`Stepper`, which gives the defaults):
 ``march_adaptive(state, t, t1, h, control, every, step0, max_steps) -> AdaptiveBlock``
     (optional, ``adaptive_blocks = True``) Adaptive steps from ``t`` towards ``t1``, compiled,
     with the same controller, norm and minimum step as :func:`march`; it returns at ``t1``,
-    at a failure, or when its record is full (then the driver calls it again).
+    at a failure, after ``max_steps`` steps, or when its record is full (then the driver
+    calls it again). ``h = 0`` asks it to choose the first step (``march(h=None)``).
+``block_interpolants`` : bool (optional, with ``blocks`` or ``adaptive_blocks``)
+    Whether each block also returns its accepted steps, ``Block.steps`` (:class:`Steps`:
+    every step's end, state and interpolant), so that runs with events, dense output or
+    ``t_eval`` march in blocks too. The driver follows each block's steps after it returns,
+    as it follows one Python step (events located on the interpolants by the same
+    :class:`~tumble.ode.events.EventTracker`, the interpolants kept, ``t_eval`` sampled);
+    with events a block takes at most :data:`EVENT_BLOCK` steps, so a terminal event costs
+    at most one block of steps beyond it. A terminal event in step ``i`` of a block cuts the
+    record there and ends the run at the event with the counters of that step, and the
+    driver calls ``rewind(block, i)`` so the stepper forgets what it counted for the
+    block's later steps. A stepper without it marches such runs in Python.
 
 What :func:`march` guarantees
 -----------------------------
@@ -62,6 +74,8 @@ What :func:`march` guarantees
   :attr:`Status.TERMINAL_EVENT`.
 * With ``t_eval``, the record holds the state at exactly those times (each step's
   interpolant between the steps) instead of every ``record_every``-th step.
+* Compiled blocks give the run that Python steps would: the same steps, record, status,
+  message, counters, events and interpolants.
 * ``progress(t)`` is called as the run goes (per block, per jump segment, every
   :data:`PROGRESS_EVERY` Python steps).
 
@@ -99,6 +113,10 @@ PROGRESS_EVERY = 256
 
 PROGRESS_BLOCKS = 50
 """A compiled run with a progress bar marches in about this many blocks."""
+
+EVENT_BLOCK = 256
+"""With events, a compiled block takes at most this many steps (a terminal event found after
+the block costs at most these steps beyond it)."""
 
 RECORD_MEMORY_SHARE = 0.5
 """A fixed-step run is refused up front when its record would need more than this share of the
@@ -168,6 +186,29 @@ class Grid(NamedTuple):
 
 
 @dataclass
+class Steps:
+    """A compiled block's accepted steps, for events, dense output and ``t_eval``
+    (``Block.steps``, from a stepper with ``block_interpolants``).
+
+    Attributes
+    ----------
+    t : ndarray, shape (m,)
+        Where each step ends (the block starts where the run stands).
+    states : sequence
+        The state at each ``t``.
+    interpolants : sequence of callable
+        ``sol(t)`` on each step (:meth:`Stepper.interpolant`).
+    n_rejected : ndarray of int, shape (m,), optional
+        Steps rejected in the block up to each accepted one (adaptive blocks).
+    """
+
+    t: np.ndarray
+    states: Sequence[Any]
+    interpolants: Sequence[Callable]
+    n_rejected: np.ndarray | None = None
+
+
+@dataclass
 class Block:
     """What a compiled block of steps returns.
 
@@ -181,12 +222,15 @@ class Block:
         The state after the block (the last finite one if it stopped).
     failed : int
         The grid step whose result was not finite (the block stopped before it), or -1.
+    steps : Steps, optional
+        Every accepted step (a stepper with ``block_interpolants``).
     """
 
     t: np.ndarray
     records: tuple
     state: Any
     failed: int = -1
+    steps: Steps | None = None
 
 
 class Stepper:
@@ -202,6 +246,8 @@ class Stepper:
     """The axis of :meth:`record`'s arrays along which samples are stacked."""
     block_steps: int | None = None
     """At most this many steps per :meth:`march_block` call (None: the whole grid)."""
+    block_interpolants: bool = False
+    """Whether its blocks return their steps (``Block.steps``) for events and dense output."""
 
     def start(self, state: Any) -> Any:
         """The stepped state for a caller's initial state (by default the same object)."""
@@ -248,6 +294,10 @@ class Stepper:
     def record(self, state: Any) -> tuple:
         return (np.asarray(state)[None],)
 
+    def rewind(self, block: Block | AdaptiveBlock, index: int) -> None:
+        """A terminal event ended the run in step ``index`` of ``block``: forget the later
+        steps (their counters)."""
+
     def march_block(
         self, state: Any, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
@@ -272,6 +322,8 @@ class AdaptiveBlock:
         None when it reached ``t1`` or filled its record; else why the run fails there
         (``"non-finite"`` with ``t_failed`` the end of the failed step, ``"minimum-step"``
         with ``finite`` whether its last error norm was finite).
+    steps : Steps, optional
+        Every accepted step (a stepper with ``block_interpolants``).
     """
 
     t: np.ndarray
@@ -284,6 +336,7 @@ class AdaptiveBlock:
     failure: str | None = None
     t_failed: float = math.nan
     finite: bool = True
+    steps: Steps | None = None
 
 
 @dataclass(frozen=True)
@@ -404,23 +457,34 @@ class _Run:
             self.times.append(block.t)
             self.samples.append(block.records)
 
+    @property
+    def follows(self) -> bool:
+        """Whether each step's interpolant is needed (events, dense output, ``t_eval``)."""
+        return self.tracker is not None or self.interpolants is not None or self.t_eval is not None
+
+    def follow(self, t_old: float, t_new: float, new: Any, sol: Callable) -> tuple[float, Any]:
+        """Events, dense output and ``t_eval`` on one accepted step's interpolant ``sol``;
+        the step's end, moved to a terminal event if one fired (the status then says so)."""
+        if self.tracker is not None:
+            t_stop = self.tracker.update(t_old, t_new, new, sol)
+            if t_stop is not None:
+                t_new, new = t_stop, sol(t_stop)
+                self.status = Status.TERMINAL_EVENT
+                self.message = Status.TERMINAL_EVENT.message
+        if self.interpolants is not None and self.step_times is not None:
+            self.interpolants.append(sol)
+            self.step_times.append(t_new)
+        if self.t_eval is not None:
+            self.sample(t_new, new, sol)
+        return t_new, new
+
     def accept(self, t_old: float, old: Any, t_new: float, new: Any) -> bool:
         """Take an accepted step; True when the run must stop (a terminal event)."""
         stepper = self.stepper
         stepper.accept(t_new, new)
         if self.tracker is not None or self.interpolants is not None or self.t_eval is not None:
             sol = stepper.interpolant(t_old, old, t_new, new)
-            if self.tracker is not None:
-                t_stop = self.tracker.update(t_old, t_new, new, sol)
-                if t_stop is not None:
-                    t_new, new = t_stop, sol(t_stop)
-                    self.status = Status.TERMINAL_EVENT
-                    self.message = Status.TERMINAL_EVENT.message
-            if self.interpolants is not None and self.step_times is not None:
-                self.interpolants.append(sol)
-                self.step_times.append(t_new)
-            if self.t_eval is not None:
-                self.sample(t_new, new, sol)
+            t_new, new = self.follow(t_old, t_new, new, sol)
         self.t, self.state = t_new, new
         self.n_steps += 1
         if self.t_eval is None and self.n_steps % self.every == 0:
@@ -513,10 +577,14 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
 def _adaptive_blocks(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, float]:
     """:func:`_adaptive` in the stepper's compiled blocks; (going on, the next step)."""
     while run.t < t1:
+        allowed = run.max_steps - run.n_steps
+        if run.tracker is not None:
+            allowed = min(allowed, EVENT_BLOCK)
         block = run.stepper.march_adaptive(
-            run.state, run.t, t1, h, control, run.every, run.n_steps, run.max_steps - run.n_steps
+            run.state, run.t, t1, h, control, run.every, run.n_steps, allowed
         )
-        run.extend(block)
+        if not _take(run, block):
+            return False, block.h
         run.n_steps += block.n_steps
         run.n_rejected += block.n_rejected
         run.t, run.state, h = block.t_end, block.state, block.h
@@ -532,6 +600,36 @@ def _adaptive_blocks(run: _Run, t1: float, h: float, control: Control) -> tuple[
         if run.progress is not None:
             run.progress(run.t)
     return True, h
+
+
+def _take(run: _Run, block: Block | AdaptiveBlock) -> bool:
+    """Keep a block's record and, if the run follows its steps (events, dense output,
+    ``t_eval``), follow them: False when a terminal event ended the run in the block (the
+    record is then cut there, the run stands at the event, with that step's counters)."""
+    if not run.follows:
+        run.extend(block)
+        return True
+    steps = block.steps
+    if steps is None:
+        raise TypeError(f"{type(run.stepper).__name__}'s blocks returned no steps")
+    t_old = run.t
+    for i, sol in enumerate(steps.interpolants):
+        t_new, new = run.follow(t_old, float(steps.t[i]), steps.states[i], sol)
+        if run.status == Status.TERMINAL_EVENT:
+            kept = block.t < steps.t[i]
+            axis = run.stepper.time_axis
+            cut = tuple(np.compress(kept, part, axis=axis) for part in block.records)
+            if run.t_eval is None:
+                run.extend(Block(block.t[kept], cut, new))
+            run.n_steps += i + 1
+            run.n_rejected += 0 if steps.n_rejected is None else int(steps.n_rejected[i])
+            run.t, run.state = t_new, new
+            run.stepper.rewind(block, i)
+            return False
+        t_old = t_new
+    if run.t_eval is None:
+        run.extend(block)
+    return True
 
 
 def _minimum_step_message(t: float, h_min: float, finite: bool) -> str:
@@ -551,10 +649,13 @@ def _blocks(run: _Run, t1: float, h: float) -> bool:
     last = grid.n if run.max_steps - run.n_steps >= grid.n else int(run.max_steps) - run.n_steps
     size = max(1, grid.n // PROGRESS_BLOCKS) if run.progress is not None else grid.n
     size = min(size, run.stepper.block_steps or size)
+    if run.tracker is not None:
+        size = min(size, EVENT_BLOCK)
     for k0 in range(0, last, size):
         k1 = min(k0 + size, last)
         block = run.stepper.march_block(run.state, grid, k0, k1, run.every, run.n_steps - k0)
-        run.extend(block)
+        if not _take(run, block):
+            return False
         done = k1 if block.failed < 0 else block.failed - 1
         run.n_steps += done - k0
         run.t, run.state = grid.time(done), block.state
@@ -622,6 +723,8 @@ def _bytes(count: float) -> str:
 
 def _segments(t0: float, t1: float, jumps: Sequence[Jump]) -> list[tuple[float, list]]:
     """``[(end, jumps applied at the end), ...]``: the span cut at the jumps' times."""
+    if not jumps:
+        return [(t1, [])]
     times = sorted({time for time, _ in jumps if t0 <= time <= t1} | {t1})
     return [(b, [apply for time, apply in jumps if time == b]) for b in times]
 
@@ -652,7 +755,8 @@ def march(
     state : object
         The state at ``t0``, of the stepper's type.
     h : float or None
-        The fixed step, or an adaptive run's first step.
+        The fixed step, or an adaptive run's first step (None: the stepper's first compiled
+        adaptive block chooses it; only with ``adaptive_blocks``).
     control : Control, optional
         Tolerances and controller: the run is adaptive. None: fixed steps of ``h``.
     events : sequence of callables
@@ -688,17 +792,17 @@ def march(
     ([0.0, 0.5, 1.0], [1.0, 0.5625, 0.31640625], <Status.SUCCESS: 0>)
     """
     t0, t1 = t_span
-    if h is None:  # the caller chooses it (a first step when adaptive) and checks it
+    blocked = not (events or dense_output or t_eval is not None) or stepper.block_interpolants
+    compiled = stepper.blocks and control is None and blocked
+    compiled_adaptive = stepper.adaptive_blocks and control is not None and blocked
+    if h is None and not compiled_adaptive:  # the caller chooses it and checks it
         raise TypeError("march needs h: the fixed step, or an adaptive run's first step")
-    step = float(h)
+    step = 0.0 if h is None else float(h)  # 0: the first compiled block chooses it
     limit = math.inf if max_steps is None else max_steps
     run = _Run(stepper, t0, state, list(events), record_every, limit, dense_output, progress,
                t_eval)  # fmt: skip
     if control is None and t_eval is None:
         check_record_size(t1 - t0, step, record_every, limit, run.samples[0], len(jumps))
-    plain = not events and not dense_output and t_eval is None
-    compiled = stepper.blocks and control is None and plain
-    compiled_adaptive = stepper.adaptive_blocks and control is not None and plain
     going = True
     for end, applied in _segments(t0, t1, jumps):
         if run.t < end:

@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from tumble import _checks
-from tumble.ode.control import initial_step, relative_tolerance
+from tumble.ode.control import StepController, initial_step, relative_tolerance
 from tumble.ode.dense import DenseOutput, StepInterpolant, step_coefficients
 from tumble.ode.driver import Control, Status, Stepper, march
 from tumble.ode.events import Event
@@ -80,6 +81,9 @@ class RungeKutta(Stepper):
     (:func:`~tumble.ode.dense.step_coefficients`).
     """
 
+    compiled_evaluations = 0
+    """Evaluations of ``fun`` made in compiled code, unseen by a Python counter."""
+
     def __init__(self, fun: Callable, tableau: ButcherTableau, t0: float, y0: np.ndarray):
         self.fun, self.tableau = fun, tableau
         self.adaptive, self.error_order = tableau.adaptive, tableau.error_order
@@ -107,31 +111,29 @@ def is_compiled(fun: object) -> bool:
     return kind.__name__ == "CPUDispatcher" and kind.__module__.startswith("numba")
 
 
-def _solve_compiled(
-    counted: _CountedFunction, tableau: ButcherTableau, t_span: tuple[float, float],
-    y: np.ndarray, h: float | None, rtol: float, atol: np.ndarray, events: list,
-    dense_output: bool, max_steps: int,
-) -> OdeResult:  # fmt: skip
-    """:func:`solve` with a compiled ``fun``: ``f(t0, y0)`` (its shape checked), then the
-    loop of :func:`tumble.ode.compiled.march` (which chooses the first step if need be)."""
-    from tumble.ode import compiled  # imports numba: only for a compiled fun
+def _stepper(
+    counted: _CountedFunction, tableau: ButcherTableau, t0: float, y: np.ndarray,
+    interpolants: bool,
+) -> RungeKutta:  # fmt: skip
+    """:func:`solve`'s stepper: :class:`RungeKutta`, or its compiled twin
+    (:class:`tumble.ode.compiled.CompiledRungeKutta`) for a compiled ``fun``; each evaluates
+    ``f(t0, y0)`` through ``counted``, which checks its shape."""
+    if not is_compiled(counted.fun):
+        return RungeKutta(counted, tableau, t0, y)
+    if not _COMPILED:
+        from tumble.ode.compiled import CompiledRungeKutta  # imports numba: only now
 
-    f0 = counted(t_span[0], y)
-    out = compiled.march(counted.fun, tableau, t_span, y, f0, h=h, nfev=counted.count,
-                         rtol=rtol, atol=atol, events=events, dense_output=dense_output,
-                         max_steps=max_steps)  # fmt: skip
-    return OdeResult(
-        t=out.t,
-        y=out.y.T,
-        t_events=[np.array(ts, dtype=float) for ts in out.t_events],
-        y_events=[np.array(ys, dtype=float).reshape(-1, y.size) for ys in out.y_events],
-        nfev=out.nfev,
-        n_steps=out.n_steps,
-        n_rejected=out.n_rejected,
-        status=out.status,
-        message=out.message,
-        sol=out.sol,
-    )
+        _COMPILED.append(CompiledRungeKutta)
+    return _COMPILED[0](counted, counted.fun, tableau, t0, y, interpolants=interpolants)
+
+
+_COMPILED: list[Callable[..., RungeKutta]] = []
+""":class:`tumble.ode.compiled.CompiledRungeKutta` once imported (a second import statement
+costs a few µs of a short run)."""
+
+
+_CONTROLLER = StepController()
+""":func:`solve`'s step controller (the defaults: one instance for every run)."""
 
 
 def _lookup(method: str) -> ButcherTableau:
@@ -145,7 +147,7 @@ def _check_span(t_span) -> tuple[float, float]:
         t0, t1 = (float(t) for t in t_span)
     except (TypeError, ValueError):
         raise _checks.fail("t_span", t_span, allowed, remedy=remedy) from None
-    if not (np.isfinite(t0) and np.isfinite(t1)) or t1 <= t0:
+    if not (math.isfinite(t0) and math.isfinite(t1)) or t1 <= t0:
         raise _checks.fail("t_span", t_span, allowed, remedy=remedy)
     return t0, t1
 
@@ -168,8 +170,10 @@ def _check_step(h, tableau: ButcherTableau) -> float | None:
     return _checks.positive("h", h)
 
 
-def _check_tolerances(rtol, atol, n: int) -> np.ndarray:
+def _check_tolerances(rtol, atol, n: int) -> np.ndarray | float:
     relative_tolerance(rtol)
+    if isinstance(atol, float | int) and not isinstance(atol, bool) and atol >= 0:
+        return _checks.non_negative("atol", atol)  # a number: no array to check
     atol_array = _checks.array("atol", atol)
     if atol_array.shape not in ((), (n,)) or np.any(atol_array < 0):
         raise _checks.fail("atol", atol, f">= 0 and finite, a scalar or of shape ({n},)")
@@ -195,8 +199,9 @@ def solve(
     ----------
     fun : callable
         Right-hand side ``fun(t, y) -> ndarray, shape (n,)``. A numba-compiled one
-        (``@numba.njit``, returning a float array) makes the whole run compiled
-        (:mod:`tumble.ode.compiled`), with the same result to round-off.
+        (``@numba.njit``, returning a float array) makes the steps compiled
+        (:mod:`tumble.ode.compiled`: the driver marches them in blocks, events and dense
+        output included), with the same result to round-off.
     t_span : (float, float)
         ``(t0, t1)`` with ``t1 > t0``. The last step lands exactly on ``t1``.
     y0 : array_like, shape (n,)
@@ -258,14 +263,11 @@ def solve(
     events = _checks.callables("events", events)
     dense_output = _checks.flag("dense_output", dense_output)
     counted = _CountedFunction(fun, y.size)
-    if is_compiled(fun):
-        return _solve_compiled(counted, tableau, (t0, t1), y, h, float(rtol), atol_array,
-                               events or [], dense_output, int(max_steps))  # fmt: skip
-    stepper = RungeKutta(counted, tableau, t0, y)
+    stepper = _stepper(counted, tableau, t0, y, bool(events) or dense_output)
     control = None
     if tableau.adaptive:
-        control = Control(float(rtol), atol_array)
-        if h is None:
+        control = Control(float(rtol), atol_array, _CONTROLLER)
+        if h is None and not stepper.adaptive_blocks:  # else the compiled loop chooses it
             h = initial_step(counted, t0, y, stepper.f, tableau.error_order, rtol, atol_array)
     # Non-finite values are detected and reported as a status, not as numpy warnings.
     with np.errstate(over="ignore", invalid="ignore"):
@@ -281,7 +283,7 @@ def solve(
         y=out.records[0].T,
         t_events=t_events,
         y_events=y_events,
-        nfev=counted.count,
+        nfev=counted.count + stepper.compiled_evaluations,
         n_steps=out.n_steps,
         n_rejected=out.n_rejected,
         status=out.status,
