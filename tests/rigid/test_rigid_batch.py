@@ -249,7 +249,7 @@ def test_columns_of_bodies_across_blocks_match_single_runs_bit_for_bit(body, met
     [
         "_lie_field_soa",
         "_quat_field_soa",
-        "_lie_advance_soa",
+        "_lie_turn_soa",
         "_combine",
         "_coefficients",
         "_loads_soa",
@@ -267,10 +267,10 @@ def test_structure_of_arrays_loops_compile_to_packed_instructions(loop):
                            np.empty((4, 12, n)), 1),
         "_quat_field_soa": (rng.normal(size=(13, n)), np.empty((9, n)), rng.normal(size=(9, n)),
                             *loads, np.empty((4, 13, n)), 1),
-        "_lie_advance_soa": (rng.normal(size=(12, n)), np.empty((12, n)),
-                             rng.normal(size=(9, n)), np.empty((3, n)), np.ones(n, dtype=bool)),
-        "_combine": (np.ones(4), 4, 0.1, rng.normal(size=(12, n)), rng.normal(size=(4, 12, n)),
-                     2, np.empty(n)),
+        "_lie_turn_soa": (rng.normal(size=(12, n)), rng.normal(size=(9, n)), np.empty((3, n)),
+                          np.ones(n, dtype=bool)),
+        "_combine": ((np.ones((1, 4)), np.arange(4)[None], np.array([4])), 0, 0.1,
+                     rng.normal(size=(12, n)), rng.normal(size=(4, 12, n)), 2, np.empty((12, n))),
         "_coefficients": (rng.normal(size=(3, n)), np.empty((3, n)), True),
         "_loads_soa": (3, rng.normal(size=(12, n)), *loads, np.empty((4, 12, n)), 1),
     }[loop]  # fmt: skip

@@ -79,60 +79,93 @@ def _dexpinv_series(x):
 
 
 @njit(**_JIT)
-def _combine(w, count, h, z, K, c, out):
-    """``out = z[c] + h Σ_{l<count} w_l K[l, c]`` for every body: the one-body sum, term by
-    term from ``0.0`` in the same order; up to four terms stay in registers (one pass)."""
-    n = out.shape[0]
+def _terms(A, b):
+    """The stage sums' terms: ``(w, l, count)`` with ``Σ_{l<i} a_il k_l`` = the sum of
+    ``w[i, t] k_{l[i, t]}`` for ``t < count[i]`` (stage ``i < s``; row ``s``: ``b``).
+
+    The zero ``a_il`` are left out when no ``b_i`` is zero, and then it changes no number:
+    the one-body sum starts from ``+0.0`` and, rounding to nearest, never becomes ``−0.0``,
+    so adding ``0·k_l = ±0`` (``k_l`` finite) leaves it as it is; a ``k_l`` that is not
+    finite makes ``z + h Σ b_i k_i`` not finite in both loops (``b_l ≠ 0``), and the body
+    stops in that step with nothing of it kept. (``rkmk4``: stages 3 and 4 have one term.)
+    """
+    s = b.shape[0]
+    skip = True
+    for i in range(s):
+        skip = skip and b[i] != 0.0
+    w, terms, count = (
+        np.zeros((s + 1, s)),
+        np.zeros((s + 1, s), np.int64),
+        np.zeros(s + 1, np.int64),
+    )
+    for i in range(s + 1):
+        for l in range(i if i < s else s):
+            weight = A[i, l] if i < s else b[l]
+            if i == s or not (skip and weight == 0.0):
+                w[i, count[i]], terms[i, count[i]] = weight, l
+                count[i] += 1
+    return w, terms, count
+
+
+@njit(**_JIT)
+def _combine(stage, i, h, z, K, c, out):
+    """``out[c] = z[c] + h Σ_t w[i, t] K[terms[i, t], c]`` for every body (``stage`` = ``(w,
+    terms, count)`` of :func:`_terms`): the one-body sum, term by term from ``0.0`` in the
+    same order; up to four terms stay in registers (one pass over the row)."""
+    w, terms, count = stage[0], stage[1], stage[2][i]
+    n = out.shape[1]
     if count == 0:
         for j in range(n):
-            out[j] = z[c, j] + h * 0.0
+            out[c, j] = z[c, j] + h * 0.0
         return
-    w0 = w[0]
+    w0, l0 = w[i, 0], terms[i, 0]
     if count == 1:
         for j in range(n):
-            out[j] = z[c, j] + h * (0.0 + w0 * K[0, c, j])
+            out[c, j] = z[c, j] + h * (0.0 + w0 * K[l0, c, j])
         return
-    w1 = w[1]
+    w1, l1 = w[i, 1], terms[i, 1]
     if count == 2:
         for j in range(n):
-            out[j] = z[c, j] + h * ((0.0 + w0 * K[0, c, j]) + w1 * K[1, c, j])
+            out[c, j] = z[c, j] + h * ((0.0 + w0 * K[l0, c, j]) + w1 * K[l1, c, j])
         return
-    w2 = w[2]
+    w2, l2 = w[i, 2], terms[i, 2]
     if count == 3:
         for j in range(n):
-            acc = (0.0 + w0 * K[0, c, j]) + w1 * K[1, c, j]
-            out[j] = z[c, j] + h * (acc + w2 * K[2, c, j])
+            acc = (0.0 + w0 * K[l0, c, j]) + w1 * K[l1, c, j]
+            out[c, j] = z[c, j] + h * (acc + w2 * K[l2, c, j])
         return
-    w3 = w[3]
+    w3, l3 = w[i, 3], terms[i, 3]
     for j in range(n):
-        acc = (0.0 + w0 * K[0, c, j]) + w1 * K[1, c, j]
-        out[j] = (acc + w2 * K[2, c, j]) + w3 * K[3, c, j]
-    for l in range(4, count):
-        wl = w[l]
+        acc = (0.0 + w0 * K[l0, c, j]) + w1 * K[l1, c, j]
+        out[c, j] = (acc + w2 * K[l2, c, j]) + w3 * K[l3, c, j]
+    for t in range(4, count):
+        wt, lt = w[i, t], terms[i, t]
         for j in range(n):
-            out[j] += wl * K[l, c, j]
+            out[c, j] += wt * K[lt, c, j]
     for j in range(n):
-        out[j] = z[c, j] + h * out[j]
+        out[c, j] = z[c, j] + h * out[c, j]
 
 
 @njit(**_JIT)
-def _stage_state(A, i, h, z, K, zs, off):
-    """``zs = z + h Σ_{l<i} a_il K_l`` (:func:`_combine`) for the numbers the fields read: all
-    but the positions ``x`` (rows ``off … off+2``), which no field or load depends on."""
+def _stage_state(stage, i, h, z, K, zs, off):
+    """``zs = z + h Σ_{l<i} a_il K_l`` (:func:`_combine`, ``stage`` from :func:`_terms`) for
+    the numbers the fields read: all but the positions ``x`` (rows ``off … off+2``), which
+    no field or load depends on."""
     for c in range(z.shape[0]):
         if c < off or c >= off + 3:
-            _combine(A[i], i, h, z, K, c, zs[c])
+            _combine(stage, i, h, z, K, c, zs)
 
 
 @njit(**_JIT)
-def _new_state(b, h, z, K, zn, bad):
-    """``zn = z + h Σ b_i K_i`` (:func:`_combine`); ``bad[j]``: body j's new state has a
-    non-finite number (``Σ 0·zn`` is 0 exactly when every number is finite, NaN otherwise)."""
-    nz, n = z.shape
+def _new_state(stage, h, z, K, zn, bad):
+    """``zn = z + h Σ b_i K_i`` (:func:`_combine`, the last row of ``stage``); ``bad[j]``:
+    body j's new state has a non-finite number (``Σ 0·zn`` is 0 exactly when every number
+    is finite, NaN otherwise)."""
+    s, (nz, n) = stage[2].shape[0] - 1, z.shape
     for j in range(n):
         bad[j] = 0.0
     for c in range(nz):
-        _combine(b, b.shape[0], h, z, K, c, zn[c])
+        _combine(stage, s, h, z, K, c, zn)
         for j in range(n):
             bad[j] += 0.0 * zn[c, j]
     any_bad = False
@@ -178,10 +211,11 @@ def _point_loads(off, R, u, a, b, points, point_forces, K, i):
 
 @njit(**_JIT)
 def _coefficients(u, coefficients, dexpinv):
-    """Per body: exp's ``(a, b)`` for ``θ²`` of ``u`` (3, B) and, if ``dexpinv``, dexp⁻¹'s
-    ``α`` into the rows of ``coefficients`` (3, B): the series for all bodies in one vector
-    loop, then the exact forms (:func:`~tumble.rigid.kernels._exp_coefficients`,
-    ``_dexpinv_coefficient``) for the few bodies whose angle is not small."""
+    """Per body: exp's ``(a, b)`` for ``θ²`` of ``u`` (rows 0 … 2 of ``u``) and, if
+    ``dexpinv``, dexp⁻¹'s ``α`` into the rows of ``coefficients`` (3, B): the series for all
+    bodies in one vector loop, then the exact forms (:func:`~tumble.rigid.kernels.
+    _exp_coefficients`, ``_dexpinv_coefficient``) for the few bodies whose angle is not
+    small."""
     n = u.shape[1]
     large = 0
     for j in range(n):
@@ -206,7 +240,7 @@ def _lie_field_soa(correct, zs, Rn, inv_I, m, F, tau, coefficients, K, i):
     ``α`` (:func:`_coefficients`), then a vector loop does the field, :func:`_loads_soa` the
     loads."""
     n = zs.shape[1]
-    _coefficients(zs[0:3], coefficients, correct)
+    _coefficients(zs, coefficients, correct)
     half = 0.5 if correct else 0.0
     for j in range(n):
         u0, u1, u2 = zs[0, j], zs[1, j], zs[2, j]
@@ -225,13 +259,11 @@ def _lie_field_soa(correct, zs, Rn, inv_I, m, F, tau, coefficients, K, i):
 
 
 @njit(**_JIT)
-def _lie_advance_soa(zn, z, Rn, coefficients, alive):
-    """:func:`~tumble.rigid.kernels._lie_advance` for the living bodies: ``R_n ← R_n
-    exp(û)`` (row r of the product is ``exp(−û)`` of row r), ``u ← 0``, ``(x, p, L)`` from
-    ``zn`` (12 rows)."""
-    n = z.shape[1]
-    _coefficients(zn[0:3], coefficients, False)
-    for j in range(n):
+def _lie_turn_soa(zn, Rn, coefficients, alive):
+    """``R_n ← R_n exp(û)`` for the living bodies (row r of the product is ``exp(−û)`` of
+    row r), ``u`` from ``zn``: :func:`~tumble.rigid.kernels._lie_advance` but ``z``."""
+    _coefficients(zn, coefficients, False)
+    for j in range(Rn.shape[1]):
         u0, u1, u2 = zn[0, j], zn[1, j], zn[2, j]
         ma, b, keep = -coefficients[0, j], coefficients[1, j], alive[j]
         for r in range(3):
@@ -240,9 +272,6 @@ def _lie_advance_soa(zn, z, Rn, coefficients, alive):
             Rn[3 * r, j] = w0 if keep else v0
             Rn[3 * r + 1, j] = w1 if keep else v1
             Rn[3 * r + 2, j] = w2 if keep else v2
-    for c in range(12):
-        for j in range(n):
-            z[c, j] = (0.0 if c < 3 else zn[c, j]) if alive[j] else z[c, j]
 
 
 @njit(**_JIT)
@@ -313,6 +342,7 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
     K, zs, zn = np.empty((s, nz, n)), np.empty((nz, n)), np.empty((nz, n))
     R, coefficients, bad = np.empty((9, n)), np.empty((3, n)), np.empty(n)
     alive, zero = np.ones(n, dtype=np.bool_), np.zeros((4, n))
+    stage, state, swapped, dead = _terms(A, b), z, False, 0
     count, until_record = 0, every
     for k in range(1, n_steps + 1):
         t_old = t_a + (k - 1) * h
@@ -320,7 +350,7 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
         if quat:
             _quat_start_soa(z)
         for i in range(s):
-            _stage_state(A, i, hk, z, K, zs, off)
+            _stage_state(stage, i, hk, z, K, zs, off)
             if quat:  # R(q/|q|) turns the points: no exp(û) (u = 0, a = b = 0)
                 _quat_field_soa(zs, R, inv_I, m, F, tau, K, i)
                 if points.shape[0]:
@@ -330,17 +360,23 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
                 if points.shape[0]:
                     _point_loads(off, Rn, zs[0:3], coefficients[0], coefficients[1], points,
                                  point_forces, K, i)  # fmt: skip
-        if _new_state(b, hk, z, K, zn, bad):
+        if _new_state(stage, hk, z, K, zn, bad):
             for j in range(n):
                 if not bad[j] == 0.0 and alive[j]:
-                    alive[j] = False
+                    alive[j], dead = False, dead + 1
                     failed[j0 + j], counts[j0 + j] = k, count
-        if quat:
+        if not quat:
+            _lie_turn_soa(zn, Rn, coefficients, alive)
+        if dead == 0:  # every body takes its new state: the arrays change places
+            z, zn, swapped = zn, z, not swapped
+        else:
             for c in range(nz):
                 for j in range(n):
                     z[c, j] = zn[c, j] if alive[j] else z[c, j]
-        else:
-            _lie_advance_soa(zn, z, Rn, coefficients, alive)
+        if not quat:  # u ← 0 (a stopped body's u is 0 already)
+            for c in range(3):
+                for j in range(n):
+                    z[c, j] = 0.0
         until_record -= 1
         if until_record == 0:
             for j in range(n):
@@ -353,6 +389,8 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
     for j in range(n):
         if alive[j]:
             counts[j0 + j], failed[j0 + j] = count, -1
+    if swapped:
+        state[:, :] = z
 
 
 @njit(**_JIT)
