@@ -298,3 +298,19 @@ def test_a_body_stopped_among_columns_ends_as_its_single_run(body, method, recor
         for name in FIELDS:
             np.testing.assert_array_equal(getattr(batch[k], name), getattr(single, name), name)
         assert batch[k].message == single.message
+
+
+@pytest.mark.parametrize("method", SOA)
+def test_stage_terms_leave_out_zero_weights_only_when_no_b_is_zero(method):
+    """soa._terms: stage i's terms are the a_il in order (row s: every b_i); a zero a_il is
+    left out exactly when every b_i is non-zero (a non-finite k_l then stops the body in
+    both loops), else kept (0·inf = nan must reach the new state as in the one-body loop)."""
+    tableau = METHODS[method].tableau
+    A, b = np.asarray(tableau.A, dtype=float), np.asarray(tableau.b, dtype=float)
+    w, terms, count = soa._terms(A, b)
+    s = len(b)
+    for i in range(s + 1):
+        weights = A[i, :i] if i < s else b
+        kept = [l for l in range(len(weights)) if weights[l] != 0 or i == s or not b.all()]
+        np.testing.assert_array_equal(terms[i, : count[i]], kept)
+        np.testing.assert_array_equal(w[i, : count[i]], weights[kept])
