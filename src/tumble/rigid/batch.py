@@ -3,8 +3,8 @@
 Body ``k`` of a batch has, bit for bit, the numbers of :func:`~tumble.rigid.simulate` run
 alone with body ``k``'s arguments. The ``lie`` and ``quat`` methods (``rkmk4``, ``rk4-quat``,
 …) run batches of at least :data:`SOA_MIN_BODIES` bodies in the structure-of-arrays loops of
-:mod:`tumble.rigid.soa` (bodies as columns, vectorised, the one-body loop's arithmetic in the
-same order); the other methods, and smaller batches, run the one-body loop of
+:mod:`tumble.rigid.soa` (bodies as columns, vectorised, the one-body loop's numbers bit for
+bit); the other methods, and smaller batches, run the one-body loop of
 :mod:`tumble.rigid.kernels` once per body, one body per thread (numba ``prange``). The
 initial states are checked and built for all bodies at once with NumPy (the same operations
 ``simulate`` applies to one body).

@@ -19,9 +19,10 @@ over the rows instead of one per term), the positions, which no field reads, get
 sum, and the exp and dexp⁻¹ series take one loop for all bodies.
 
 The arithmetic is the one-body loop's, operation for operation in the same order
-(:func:`~tumble.rigid.kernels._lie_field`, ``_quat_field``, ``_loads``, the stage sums): no
-fastmath, so no reassociation or fused multiply-add, and every body gets bit for bit the
-numbers of :func:`~tumble.rigid.simulate` (the batch tests compare with ``assert_array_equal``).
+(:func:`~tumble.rigid.kernels._lie_field`, ``_quat_field``, ``_loads``, the stage sums, less
+the zero terms of a tableau, which change no number: :func:`_terms`): no fastmath, so no
+reassociation or fused multiply-add, and every body gets bit for bit the numbers of
+:func:`~tumble.rigid.simulate` (the batch tests compare with ``assert_array_equal``).
 The two branches of that arithmetic become: the ``exp`` and ``dexp⁻¹`` coefficients from
 their series for all bodies (a vector loop), then the few bodies whose angle is at least
 :data:`~tumble.rigid.kernels.SERIES_ANGLE` recomputed by the one-body functions (a scalar
