@@ -245,27 +245,40 @@ def test_columns_of_bodies_across_blocks_match_single_runs_bit_for_bit(body, met
 
 
 @pytest.mark.parametrize(
-    "loop", ["_lie_field_soa", "_quat_field_soa", "_lie_advance_soa", "_stage_state"]
+    "loop",
+    [
+        "_lie_field_soa",
+        "_quat_field_soa",
+        "_lie_turn_soa",
+        "_combine",
+        "_coefficients",
+        "_loads_soa",
+    ],
 )
 def test_structure_of_arrays_loops_compile_to_packed_instructions(loop):
     """Each loop over bodies is vectorised: compiled afresh (cached code cannot be
-    inspected), its assembly multiplies four or eight doubles at once (vmulpd on ymm/zmm)."""
+    inspected), its assembly multiplies or divides four or eight doubles at once (vmulpd,
+    vdivpd on ymm/zmm)."""
     n, rng = 16, np.random.default_rng(0)
+    loads = (np.ones(n), rng.normal(size=(3, n)), rng.normal(size=3))  # m, F, tau
     arguments = {
         "_lie_field_soa": (True, rng.normal(size=(12, n)), rng.normal(size=(9, n)),
-                           rng.normal(size=(9, n)), np.empty((4, n)), np.empty((4, 12, n)), 1),
+                           rng.normal(size=(9, n)), *loads, np.empty((3, n)),
+                           np.empty((4, 12, n)), 1),
         "_quat_field_soa": (rng.normal(size=(13, n)), np.empty((9, n)), rng.normal(size=(9, n)),
-                            np.empty((4, 13, n)), 1),
-        "_lie_advance_soa": (rng.normal(size=(12, n)), np.empty((12, n)),
-                             rng.normal(size=(9, n)), np.empty((4, n)), np.ones(n, dtype=bool)),
-        "_stage_state": (np.eye(4), 2, 0.1, rng.normal(size=(12, n)),
-                         rng.normal(size=(4, 12, n)), np.empty((12, n)), np.empty(n)),
+                            *loads, np.empty((4, 13, n)), 1),
+        "_lie_turn_soa": (rng.normal(size=(12, n)), rng.normal(size=(9, n)), np.empty((3, n)),
+                          np.ones(n, dtype=bool)),
+        "_combine": ((np.ones((1, 4)), np.arange(4)[None], np.array([4])), 0, 0.1,
+                     rng.normal(size=(12, n)), rng.normal(size=(4, 12, n)), 2, np.empty((12, n))),
+        "_coefficients": (rng.normal(size=(3, n)), np.empty((3, n)), True),
+        "_loads_soa": (3, rng.normal(size=(12, n)), *loads, np.empty((4, 12, n)), 1),
     }[loop]  # fmt: skip
     fresh = numba.njit(error_model="numpy")(getattr(soa, loop).py_func)
     fresh(*arguments)
     assembly = "".join(fresh.inspect_asm().values())
-    packed = re.findall(r"\bvmulpd\s+[^\n]*%[yz]mm", assembly)
-    assert len(packed) >= 4, f"{loop}: {len(packed)} packed multiplies"
+    packed = re.findall(r"\bv(?:mul|div)pd\s+[^\n]*%[yz]mm", assembly)
+    assert len(packed) >= 3, f"{loop}: {len(packed)} packed multiplies or divides"
 
 
 @pytest.mark.parametrize("record_every", [1, 3])
@@ -285,3 +298,19 @@ def test_a_body_stopped_among_columns_ends_as_its_single_run(body, method, recor
         for name in FIELDS:
             np.testing.assert_array_equal(getattr(batch[k], name), getattr(single, name), name)
         assert batch[k].message == single.message
+
+
+@pytest.mark.parametrize("method", SOA)
+def test_stage_terms_leave_out_zero_weights_only_when_no_b_is_zero(method):
+    """soa._terms: stage i's terms are the a_il in order (row s: every b_i); a zero a_il is
+    left out exactly when every b_i is non-zero (a non-finite k_l then stops the body in
+    both loops), else kept (0·inf = nan must reach the new state as in the one-body loop)."""
+    tableau = METHODS[method].tableau
+    A, b = np.asarray(tableau.A, dtype=float), np.asarray(tableau.b, dtype=float)
+    w, terms, count = soa._terms(A, b)
+    s = len(b)
+    for i in range(s + 1):
+        weights = A[i, :i] if i < s else b
+        kept = [l for l in range(len(weights)) if weights[l] != 0 or i == s or not b.all()]
+        np.testing.assert_array_equal(terms[i, : count[i]], kept)
+        np.testing.assert_array_equal(w[i, : count[i]], weights[kept])

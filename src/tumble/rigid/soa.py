@@ -3,23 +3,31 @@
 :func:`~tumble.rigid.simulate_batch` runs every body through the one-body loop of
 :mod:`tumble.rigid.kernels` (one body at a time per thread: "array of structures"). Here the
 ``lie`` and ``quat`` charts (``rkmk4``, ``rkmk8``, ``lie-euler``, ``seed-rk4``, ``rk4-quat``,
-``euler-quat``) get a second loop for batches in which the bodies are the columns: the state
-is ``Z`` (nz, N) and ``R_n`` (9, N), the body data ``I⁻¹`` (9, N), ``m`` (N,), ``F`` (3, N).
-A block of :data:`BLOCK` bodies is copied into contiguous work arrays and marched over the
-whole grid; each stage is a few loops over the bodies of the block whose bodies are plain
-arithmetic on contiguous rows, so LLVM turns them into packed (SIMD) instructions
-(``tests/rigid/test_rigid_batch.py`` checks the assembly for packed ``vmulpd``/``vaddpd``).
-The blocks run in parallel (``prange``).
+``euler-quat``) get a second loop in which the bodies are columns: :func:`run_batch` takes
+the batch as it is (``Z`` (N, nz), ``R_n`` (N, 3, 3), the body data in the
+:class:`~tumble.rigid.kernels.Problem`) and each block of :data:`BLOCK` bodies copies its
+columns into contiguous work arrays (``z`` (nz, B), ``R_n`` (9, B), ``I⁻¹`` (9, B), ``m``
+(B,), ``F`` (3, B)), marches them over the whole grid and copies them back; the blocks run in
+parallel (``prange``), so the transposes do too. Each stage is a few loops over the bodies
+of the block whose bodies are plain arithmetic on contiguous rows, so LLVM turns them into
+packed (SIMD) instructions (``tests/rigid/test_rigid_batch.py`` checks the assembly for
+packed ``vmulpd``). What keeps them packed: no call and no branch in a loop over bodies (the
+rare branches run as a second, scalar loop after it), and few rows written per loop (a loop
+that also wrote the nine rows of the loads was judged not worth vectorising). What makes
+them cheap: a stage sum keeps up to four terms in a register (:func:`_combine`: one pass
+over the rows instead of one per term), the positions, which no field reads, get no stage
+sum, and the exp and dexp⁻¹ series take one loop for all bodies.
 
 The arithmetic is the one-body loop's, operation for operation in the same order
-(:func:`~tumble.rigid.kernels._lie_field`, ``_quat_field``, ``_loads``, the stage sums): no
-fastmath, so no reassociation or fused multiply-add, and every body gets bit for bit the
-numbers of :func:`~tumble.rigid.simulate` (the batch tests compare with ``assert_array_equal``).
+(:func:`~tumble.rigid.kernels._lie_field`, ``_quat_field``, ``_loads``, the stage sums, less
+the zero terms of a tableau, which change no number: :func:`_terms`): no fastmath, so no
+reassociation or fused multiply-add, and every body gets bit for bit the numbers of
+:func:`~tumble.rigid.simulate` (the batch tests compare with ``assert_array_equal``).
 The two branches of that arithmetic become: the ``exp`` and ``dexp⁻¹`` coefficients from
 their series for all bodies (a vector loop), then the few bodies whose angle is at least
 :data:`~tumble.rigid.kernels.SERIES_ANGLE` recomputed by the one-body functions (a scalar
 loop); a body whose new state is not finite stops alone, as in the one-body loop (its state
-is left at the step before; the test ``x − x == 0`` on the sum of its numbers is vectorised,
+is left at the step before; the test ``Σ 0·x == 0`` on its numbers is vectorised,
 the bookkeeping of a stop is scalar and rare).
 """
 
@@ -43,9 +51,11 @@ from tumble.rigid.kernels import (
     _S4,
     _S5,
     _SERIES2,
+    _cross,
     _dexpinv_coefficient,
     _exp_coefficients,
     _quat_matrix,
+    _rotate,
 )
 
 BLOCK = 256
@@ -53,60 +63,111 @@ BLOCK = 256
 
 
 @njit(**_JIT)
-def _series(u, theta2, a, b, alpha, dexpinv):
-    """Per body: ``θ²`` of ``u`` (3, B), exp's ``(a, b)`` and, if ``dexpinv``, dexp⁻¹'s ``α``
-    (:func:`~tumble.rigid.kernels._exp_coefficients` and ``_dexpinv_coefficient``): the series
-    for all bodies (vectorised), then the exact forms where the angle is not small."""
-    n = theta2.shape[0]
-    for j in range(n):
-        x = u[0, j] * u[0, j] + u[1, j] * u[1, j] + u[2, j] * u[2, j]
-        theta2[j] = x
-        a[j] = 1.0 + x * (_S1 + x * (_S2 + x * (_S3 + x * (_S4 + x * _S5))))
-        b[j] = 0.5 + x * (_C1 + x * (_C2 + x * (_C3 + x * (_C4 + x * _C5))))
-    if dexpinv:
-        for j in range(n):
-            x = theta2[j]
-            tail = 1 / 1209600 + x * (1 / 47900160 + x * (691 / 1307674368000))
-            alpha[j] = 1 / 12 + x * (1 / 720 + x * (1 / 30240 + x * tail))
-    for j in range(n):
-        if theta2[j] >= _SERIES2:
-            a[j], b[j] = _exp_coefficients(theta2[j])
-            if dexpinv:
-                alpha[j] = _dexpinv_coefficient(theta2[j])
+def _exp_series(x):
+    """exp's ``(a, b) = (sin θ/θ, (1 − cos θ)/θ²)`` for ``θ² = x`` from their series, as
+    :func:`~tumble.rigid.kernels._exp_coefficients` below :data:`SERIES_ANGLE`."""
+    a = 1.0 + x * (_S1 + x * (_S2 + x * (_S3 + x * (_S4 + x * _S5))))
+    b = 0.5 + x * (_C1 + x * (_C2 + x * (_C3 + x * (_C4 + x * _C5))))
+    return a, b
 
 
 @njit(**_JIT)
-def _stage_state(A, i, h, z, K, zs, acc):
-    """``zs = z + h Σ_{l<i} a_il K_l`` for every number of every body: the one-body sums,
-    term by term in the same order, with the loop over bodies innermost (``acc`` (B,))."""
-    nz, n = z.shape
-    for c in range(nz):
-        for j in range(n):
-            acc[j] = 0.0
-        for l in range(i):
-            a = A[i, l]
-            for j in range(n):
-                acc[j] += a * K[l, c, j]
-        for j in range(n):
-            zs[c, j] = z[c, j] + h * acc[j]
+def _dexpinv_series(x):
+    """dexp⁻¹'s ``α`` from its series, as :func:`~tumble.rigid.kernels._dexpinv_coefficient`
+    below :data:`SERIES_ANGLE`."""
+    tail = 1 / 1209600 + x * (1 / 47900160 + x * (691 / 1307674368000))
+    return 1 / 12 + x * (1 / 720 + x * (1 / 30240 + x * tail))
 
 
 @njit(**_JIT)
-def _new_state(b, h, z, K, zn, bad, acc):
-    """``zn = z + h Σ b_i K_i`` (as :func:`_stage_state`); ``bad[j]``: body j's new state has
-    a non-finite number (``Σ 0·zn`` is 0 exactly when every number is finite, NaN otherwise)."""
-    nz, n = z.shape
+def _terms(A, b):
+    """The stage sums' terms: ``(w, l, count)`` with ``Σ_{l<i} a_il k_l`` = the sum of
+    ``w[i, t] k_{l[i, t]}`` for ``t < count[i]`` (stage ``i < s``; row ``s``: ``b``).
+
+    The zero ``a_il`` are left out when no ``b_i`` is zero, and then it changes no number:
+    the one-body sum starts from ``+0.0`` and, rounding to nearest, never becomes ``−0.0``,
+    so adding ``0·k_l = ±0`` (``k_l`` finite) leaves it as it is; a ``k_l`` that is not
+    finite makes ``z + h Σ b_i k_i`` not finite in both loops (``b_l ≠ 0``), and the body
+    stops in that step with nothing of it kept. (``rkmk4``: stages 3 and 4 have one term.)
+    """
+    s = b.shape[0]
+    skip = True
+    for i in range(s):
+        skip = skip and b[i] != 0.0
+    w, terms, count = (
+        np.zeros((s + 1, s)),
+        np.zeros((s + 1, s), np.int64),
+        np.zeros(s + 1, np.int64),
+    )
+    for i in range(s + 1):
+        for l in range(i if i < s else s):
+            weight = A[i, l] if i < s else b[l]
+            if i == s or not (skip and weight == 0.0):
+                w[i, count[i]], terms[i, count[i]] = weight, l
+                count[i] += 1
+    return w, terms, count
+
+
+@njit(**_JIT)
+def _combine(stage, i, h, z, K, c, out):
+    """``out[c] = z[c] + h Σ_t w[i, t] K[terms[i, t], c]`` for every body (``stage`` = ``(w,
+    terms, count)`` of :func:`_terms`): the one-body sum, term by term from ``0.0`` in the
+    same order; up to four terms stay in registers (one pass over the row)."""
+    w, terms, count = stage[0], stage[1], stage[2][i]
+    n = out.shape[1]
+    if count == 0:
+        for j in range(n):
+            out[c, j] = z[c, j] + h * 0.0
+        return
+    w0, l0 = w[i, 0], terms[i, 0]
+    if count == 1:
+        for j in range(n):
+            out[c, j] = z[c, j] + h * (0.0 + w0 * K[l0, c, j])
+        return
+    w1, l1 = w[i, 1], terms[i, 1]
+    if count == 2:
+        for j in range(n):
+            out[c, j] = z[c, j] + h * ((0.0 + w0 * K[l0, c, j]) + w1 * K[l1, c, j])
+        return
+    w2, l2 = w[i, 2], terms[i, 2]
+    if count == 3:
+        for j in range(n):
+            acc = (0.0 + w0 * K[l0, c, j]) + w1 * K[l1, c, j]
+            out[c, j] = z[c, j] + h * (acc + w2 * K[l2, c, j])
+        return
+    w3, l3 = w[i, 3], terms[i, 3]
+    for j in range(n):
+        acc = (0.0 + w0 * K[l0, c, j]) + w1 * K[l1, c, j]
+        out[c, j] = (acc + w2 * K[l2, c, j]) + w3 * K[l3, c, j]
+    for t in range(4, count):
+        wt, lt = w[i, t], terms[i, t]
+        for j in range(n):
+            out[c, j] += wt * K[lt, c, j]
+    for j in range(n):
+        out[c, j] = z[c, j] + h * out[c, j]
+
+
+@njit(**_JIT)
+def _stage_state(stage, i, h, z, K, zs, off):
+    """``zs = z + h Σ_{l<i} a_il K_l`` (:func:`_combine`, ``stage`` from :func:`_terms`) for
+    the numbers the fields read: all but the positions ``x`` (rows ``off … off+2``), which
+    no field or load depends on."""
+    for c in range(z.shape[0]):
+        if c < off or c >= off + 3:
+            _combine(stage, i, h, z, K, c, zs)
+
+
+@njit(**_JIT)
+def _new_state(stage, h, z, K, zn, bad):
+    """``zn = z + h Σ b_i K_i`` (:func:`_combine`, the last row of ``stage``); ``bad[j]``:
+    body j's new state has a non-finite number (``Σ 0·zn`` is 0 exactly when every number
+    is finite, NaN otherwise)."""
+    s, (nz, n) = stage[2].shape[0] - 1, z.shape
     for j in range(n):
         bad[j] = 0.0
     for c in range(nz):
+        _combine(stage, s, h, z, K, c, zn)
         for j in range(n):
-            acc[j] = 0.0
-        for i in range(b.shape[0]):
-            w = b[i]
-            for j in range(n):
-                acc[j] += w * K[i, c, j]
-        for j in range(n):
-            zn[c, j] = z[c, j] + h * acc[j]
             bad[j] += 0.0 * zn[c, j]
     any_bad = False
     for j in range(n):
@@ -115,43 +176,72 @@ def _new_state(b, h, z, K, zn, bad, acc):
 
 
 @njit(**_JIT)
-def _loads_soa(off, zs, R, u, a, b, m, F, tau, points, point_forces, K, i):
-    """:func:`~tumble.rigid.kernels._loads` for every body: ``ẋ = p/m``, ``ṗ = F + Σ f_k``,
-    ``L̇ = τ + Σ (R exp(û) r_k) × f_k`` (``R`` (9, B) row-major; ``u`` (3, B) or None)."""
-    n = m.shape[0]
-    for c in range(3):
-        for j in range(n):
-            K[i, off + c, j] = zs[off + 3 + c, j] / m[j]
-            K[i, off + 3 + c, j] = F[c, j]
-            K[i, off + 6 + c, j] = tau[c]
+def _loads_soa(off, zs, m, F, tau, K, i):
+    """:func:`~tumble.rigid.kernels._loads` but the points' for every body: ``ẋ = p/m``,
+    ``ṗ = F``, ``L̇ = τ`` (rows ``off …`` of ``K[i]``; ``zs[off:]`` = ``(x, p, L)``)."""
+    t0, t1, t2 = tau[0], tau[1], tau[2]
+    for j in range(m.shape[0]):
+        K[i, off, j] = zs[off + 3, j] / m[j]
+        K[i, off + 1, j] = zs[off + 4, j] / m[j]
+        K[i, off + 2, j] = zs[off + 5, j] / m[j]
+        K[i, off + 3, j], K[i, off + 4, j], K[i, off + 5, j] = F[0, j], F[1, j], F[2, j]
+        K[i, off + 6, j], K[i, off + 7, j], K[i, off + 8, j] = t0, t1, t2
+
+
+@njit(**_JIT)
+def _point_loads(off, R, u, a, b, points, point_forces, K, i):
+    """The point loads of :func:`~tumble.rigid.kernels._loads` for every body:
+    ``ṗ += f_k``, ``L̇ += (R exp(û) r_k) × f_k`` (``R`` (9, B) row-major; ``u`` (3, B))."""
+    n = K.shape[2]
     for k in range(points.shape[0]):
         v0, v1, v2 = points[k, 0], points[k, 1], points[k, 2]
         f0, f1, f2 = point_forces[k, 0], point_forces[k, 1], point_forces[k, 2]
         for j in range(n):
-            u0, u1, u2 = u[0, j], u[1, j], u[2, j]
-            c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
-            d0, d1, d2 = u1 * c2 - u2 * c1, u2 * c0 - u0 * c2, u0 * c1 - u1 * c0
-            r0 = v0 + a[j] * c0 + b[j] * d0
-            r1 = v1 + a[j] * c1 + b[j] * d1
-            r2 = v2 + a[j] * c2 + b[j] * d2
+            r0, r1, r2 = _rotate(a[j], b[j], u[0, j], u[1, j], u[2, j], v0, v1, v2)
             s0 = R[0, j] * r0 + R[1, j] * r1 + R[2, j] * r2
             s1 = R[3, j] * r0 + R[4, j] * r1 + R[5, j] * r2
             s2 = R[6, j] * r0 + R[7, j] * r1 + R[8, j] * r2
+            t0, t1, t2 = _cross(s0, s1, s2, f0, f1, f2)
             K[i, off + 3, j] += f0
             K[i, off + 4, j] += f1
             K[i, off + 5, j] += f2
-            K[i, off + 6, j] += s1 * f2 - s2 * f1
-            K[i, off + 7, j] += s2 * f0 - s0 * f2
-            K[i, off + 8, j] += s0 * f1 - s1 * f0
+            K[i, off + 6, j] += t0
+            K[i, off + 7, j] += t1
+            K[i, off + 8, j] += t2
 
 
 @njit(**_JIT)
-def _lie_field_soa(correct, zs, Rn, inv_I, coefficients, K, i):
-    """:func:`~tumble.rigid.kernels._lie_field` for every body: ``u̇ = dexp⁻¹_{−u}(ω)``,
-    ``ω = I⁻¹ exp(−û) R_nᵀ L``; ``coefficients`` = ``(θ², a, b, α)`` work rows (4, B)."""
+def _coefficients(u, coefficients, dexpinv):
+    """Per body: exp's ``(a, b)`` for ``θ²`` of ``u`` (rows 0 … 2 of ``u``) and, if
+    ``dexpinv``, dexp⁻¹'s ``α`` into the rows of ``coefficients`` (3, B): the series for all
+    bodies in one vector loop, then the exact forms (:func:`~tumble.rigid.kernels.
+    _exp_coefficients`, ``_dexpinv_coefficient``) for the few bodies whose angle is not
+    small."""
+    n = u.shape[1]
+    large = 0
+    for j in range(n):
+        x = u[0, j] * u[0, j] + u[1, j] * u[1, j] + u[2, j] * u[2, j]
+        large += x >= _SERIES2
+        coefficients[0, j], coefficients[1, j] = _exp_series(x)
+        coefficients[2, j] = _dexpinv_series(x) if dexpinv else 0.0
+    if large == 0:
+        return
+    for j in range(n):
+        x = u[0, j] * u[0, j] + u[1, j] * u[1, j] + u[2, j] * u[2, j]
+        if x >= _SERIES2:
+            coefficients[0, j], coefficients[1, j] = _exp_coefficients(x)
+            coefficients[2, j] = _dexpinv_coefficient(x) if dexpinv else 0.0
+
+
+@njit(**_JIT)
+def _lie_field_soa(correct, zs, Rn, inv_I, m, F, tau, coefficients, K, i):
+    """:func:`~tumble.rigid.kernels._lie_field` and the loads but the points'
+    (:func:`~tumble.rigid.kernels._loads`) for every body: ``u̇ = dexp⁻¹_{−u}(ω)``,
+    ``ω = I⁻¹ exp(−û) R_nᵀ L``; ``coefficients`` (3, B) gets exp's ``(a, b)`` and dexp⁻¹'s
+    ``α`` (:func:`_coefficients`), then a vector loop does the field, :func:`_loads_soa` the
+    loads."""
     n = zs.shape[1]
-    theta2, a, b, alpha = coefficients[0], coefficients[1], coefficients[2], coefficients[3]
-    _series(zs[0:3], theta2, a, b, alpha, correct)
+    _coefficients(zs, coefficients, correct)
     half = 0.5 if correct else 0.0
     for j in range(n):
         u0, u1, u2 = zs[0, j], zs[1, j], zs[2, j]
@@ -159,50 +249,37 @@ def _lie_field_soa(correct, zs, Rn, inv_I, coefficients, K, i):
         v0 = Rn[0, j] * L0 + Rn[3, j] * L1 + Rn[6, j] * L2
         v1 = Rn[1, j] * L0 + Rn[4, j] * L1 + Rn[7, j] * L2
         v2 = Rn[2, j] * L0 + Rn[5, j] * L1 + Rn[8, j] * L2
-        ma = -a[j]
-        c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
-        d0, d1, d2 = u1 * c2 - u2 * c1, u2 * c0 - u0 * c2, u0 * c1 - u1 * c0
-        e0, e1, e2 = v0 + ma * c0 + b[j] * d0, v1 + ma * c1 + b[j] * d1, v2 + ma * c2 + b[j] * d2
+        e0, e1, e2 = _rotate(-coefficients[0, j], coefficients[1, j], u0, u1, u2, v0, v1, v2)
         w0 = inv_I[0, j] * e0 + inv_I[1, j] * e1 + inv_I[2, j] * e2
         w1 = inv_I[3, j] * e0 + inv_I[4, j] * e1 + inv_I[5, j] * e2
         w2 = inv_I[6, j] * e0 + inv_I[7, j] * e1 + inv_I[8, j] * e2
-        al = alpha[j] if correct else 0.0
-        c0, c1, c2 = u1 * w2 - u2 * w1, u2 * w0 - u0 * w2, u0 * w1 - u1 * w0
-        d0, d1, d2 = u1 * c2 - u2 * c1, u2 * c0 - u0 * c2, u0 * c1 - u1 * c0
-        K[i, 0, j] = w0 + half * c0 + al * d0
-        K[i, 1, j] = w1 + half * c1 + al * d1
-        K[i, 2, j] = w2 + half * c2 + al * d2
+        K[i, 0, j], K[i, 1, j], K[i, 2, j] = _rotate(
+            half, coefficients[2, j], u0, u1, u2, w0, w1, w2
+        )
+    _loads_soa(3, zs, m, F, tau, K, i)
 
 
 @njit(**_JIT)
-def _lie_advance_soa(zn, z, Rn, coefficients, alive):
-    """:func:`~tumble.rigid.kernels._lie_advance` for the living bodies: ``R_n ← R_n
-    exp(û)``, ``u ← 0``, ``(x, p, L)`` from ``zn``."""
-    n = z.shape[1]
-    theta2, a, b = coefficients[0], coefficients[1], coefficients[2]
-    _series(zn[0:3], theta2, a, b, coefficients[3], False)
-    for r in range(3):
-        for j in range(n):
-            u0, u1, u2 = zn[0, j], zn[1, j], zn[2, j]
+def _lie_turn_soa(zn, Rn, coefficients, alive):
+    """``R_n ← R_n exp(û)`` for the living bodies (row r of the product is ``exp(−û)`` of
+    row r), ``u`` from ``zn``: :func:`~tumble.rigid.kernels._lie_advance` but ``z``."""
+    _coefficients(zn, coefficients, False)
+    for j in range(Rn.shape[1]):
+        u0, u1, u2 = zn[0, j], zn[1, j], zn[2, j]
+        ma, b, keep = -coefficients[0, j], coefficients[1, j], alive[j]
+        for r in range(3):
             v0, v1, v2 = Rn[3 * r, j], Rn[3 * r + 1, j], Rn[3 * r + 2, j]
-            ma = -a[j]
-            c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
-            d0, d1, d2 = u1 * c2 - u2 * c1, u2 * c0 - u0 * c2, u0 * c1 - u1 * c0
-            keep = alive[j]
-            Rn[3 * r, j] = v0 + ma * c0 + b[j] * d0 if keep else v0
-            Rn[3 * r + 1, j] = v1 + ma * c1 + b[j] * d1 if keep else v1
-            Rn[3 * r + 2, j] = v2 + ma * c2 + b[j] * d2 if keep else v2
-    for c in range(z.shape[0]):
-        for j in range(n):
-            new = (0.0 if c < 3 else zn[c, j]) if alive[j] else z[c, j]
-            z[c, j] = new
+            w0, w1, w2 = _rotate(ma, b, u0, u1, u2, v0, v1, v2)
+            Rn[3 * r, j] = w0 if keep else v0
+            Rn[3 * r + 1, j] = w1 if keep else v1
+            Rn[3 * r + 2, j] = w2 if keep else v2
 
 
 @njit(**_JIT)
-def _quat_field_soa(zs, R, inv_I, K, i):
-    """:func:`~tumble.rigid.kernels._quat_field` for every body: ``q̇ = ½ q ⊗ (0, ω)``,
-    ``ω = I⁻¹ Rᵀ L`` with ``R = R(q/|q|)`` written to ``R`` (9, B) (two loops: each
-    vectorises)."""
+def _quat_field_soa(zs, R, inv_I, m, F, tau, K, i):
+    """:func:`~tumble.rigid.kernels._quat_field` and the loads but the points' for every
+    body: ``q̇ = ½ q ⊗ (0, ω)``, ``ω = I⁻¹ Rᵀ L`` with ``R = R(q/|q|)`` written to ``R``
+    (9, B) (two loops: each vectorises)."""
     n = zs.shape[1]
     for j in range(n):
         q0, q1, q2, q3 = zs[0, j], zs[1, j], zs[2, j], zs[3, j]
@@ -226,6 +303,7 @@ def _quat_field_soa(zs, R, inv_I, K, i):
         K[i, 1, j] = 0.5 * (q0 * w0 + q2 * w2 - q3 * w1)
         K[i, 2, j] = 0.5 * (q0 * w1 + q3 * w0 - q1 * w2)
         K[i, 3, j] = 0.5 * (q0 * w2 + q1 * w1 - q2 * w0)
+    _loads_soa(4, zs, m, F, tau, K, i)
 
 
 @njit(**_JIT)
@@ -261,9 +339,11 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
     tau, points, point_forces = problem.tau, problem.points, problem.point_forces
     t_a, t_b, h, n_steps = grid
     s, (nz, n) = b.shape[0], z.shape
+    off = 4 if quat else 3
     K, zs, zn = np.empty((s, nz, n)), np.empty((nz, n)), np.empty((nz, n))
-    R, coefficients, bad, acc = np.empty((9, n)), np.empty((4, n)), np.empty(n), np.empty(n)
+    R, coefficients, bad = np.empty((9, n)), np.empty((3, n)), np.empty(n)
     alive, zero = np.ones(n, dtype=np.bool_), np.zeros((4, n))
+    stage, state, swapped, dead = _terms(A, b), z, False, 0
     count, until_record = 0, every
     for k in range(1, n_steps + 1):
         t_old = t_a + (k - 1) * h
@@ -271,26 +351,33 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
         if quat:
             _quat_start_soa(z)
         for i in range(s):
-            _stage_state(A, i, hk, z, K, zs, acc)
+            _stage_state(stage, i, hk, z, K, zs, off)
             if quat:  # R(q/|q|) turns the points: no exp(û) (u = 0, a = b = 0)
-                _quat_field_soa(zs, R, inv_I, K, i)
-                _loads_soa(4, zs, R, zero[0:3], zero[3], zero[3], m, F, tau, points,
-                           point_forces, K, i)  # fmt: skip
+                _quat_field_soa(zs, R, inv_I, m, F, tau, K, i)
+                if points.shape[0]:
+                    _point_loads(off, R, zero[0:3], zero[3], zero[3], points, point_forces, K, i)
             else:
-                _lie_field_soa(correct, zs, Rn, inv_I, coefficients, K, i)
-                _loads_soa(3, zs, Rn, zs[0:3], coefficients[1], coefficients[2], m, F, tau,
-                           points, point_forces, K, i)  # fmt: skip
-        if _new_state(b, hk, z, K, zn, bad, acc):
+                _lie_field_soa(correct, zs, Rn, inv_I, m, F, tau, coefficients, K, i)
+                if points.shape[0]:
+                    _point_loads(off, Rn, zs[0:3], coefficients[0], coefficients[1], points,
+                                 point_forces, K, i)  # fmt: skip
+        if _new_state(stage, hk, z, K, zn, bad):
             for j in range(n):
                 if not bad[j] == 0.0 and alive[j]:
-                    alive[j] = False
+                    alive[j], dead = False, dead + 1
                     failed[j0 + j], counts[j0 + j] = k, count
-        if quat:
+        if not quat:
+            _lie_turn_soa(zn, Rn, coefficients, alive)
+        if dead == 0:  # every body takes its new state: the arrays change places
+            z, zn, swapped = zn, z, not swapped
+        else:
             for c in range(nz):
                 for j in range(n):
                     z[c, j] = zn[c, j] if alive[j] else z[c, j]
-        else:
-            _lie_advance_soa(zn, z, Rn, coefficients, alive)
+        if not quat:  # u ← 0 (a stopped body's u is 0 already)
+            for c in range(3):
+                for j in range(n):
+                    z[c, j] = 0.0
         until_record -= 1
         if until_record == 0:
             for j in range(n):
@@ -303,22 +390,39 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
     for j in range(n):
         if alive[j]:
             counts[j0 + j], failed[j0 + j] = count, -1
+    if swapped:
+        state[:, :] = z
+
+
+@njit(**_JIT)
+def _columns(rows, j0, j1):
+    """``rows[j0:j1].T`` (bodies as rows, flattened) as a contiguous (…, j1 − j0) array."""
+    flat = rows.reshape(rows.shape[0], -1)
+    out = np.empty((flat.shape[1], j1 - j0))
+    for j in range(j1 - j0):
+        for c in range(flat.shape[1]):
+            out[c, j] = flat[j0 + j, c]
+    return out
 
 
 @njit(parallel=True, **_JIT)
-def run_batch(quat, problem, grid, Z, RN, inv_I, m, F, every, records, counts, failed):
-    """Every body of a batch, :data:`BLOCK` at a time in parallel: ``Z`` (nz, N), ``RN``
-    (9, N), ``inv_I`` (9, N), ``m`` (N,), ``F`` (3, N) (the columns are the bodies; ``Z``,
-    ``RN`` end as the last states); ``problem`` holds the tableau and the shared loads
-    (:class:`~tumble.rigid.kernels.Problem`). ``records``, ``counts``, ``failed`` as for
-    :func:`~tumble.rigid.kernels._batch` (the cause of a stop is always ``NON_FINITE``)."""
-    n_bodies = Z.shape[1]
+def run_batch(quat, problem, grid, Z, RN, every, records, counts, failed):
+    """Every body of a batch, :data:`BLOCK` at a time in parallel: ``Z`` (N, nz), ``RN``
+    (N, 3, 3) (end as the last states), body ``k``'s data ``problem.inv_I[k]`` (3, 3),
+    ``problem.m[k]``, ``problem.F[k]`` (3,) and the shared loads (:class:`~tumble.rigid.
+    kernels.Problem`); each block works on its bodies as columns (copied in and out).
+    ``records``, ``counts``, ``failed`` as for :func:`~tumble.rigid.kernels._batch` (the
+    cause of a stop is always ``NON_FINITE``)."""
+    n_bodies = Z.shape[0]
     for block in prange((n_bodies + BLOCK - 1) // BLOCK):
         j0 = block * BLOCK
         j1 = min(j0 + BLOCK, n_bodies)
-        z, Rn = np.ascontiguousarray(Z[:, j0:j1]), np.ascontiguousarray(RN[:, j0:j1])
-        _block(quat, problem, grid, z, Rn, np.ascontiguousarray(inv_I[:, j0:j1]),
-               np.ascontiguousarray(m[j0:j1]), np.ascontiguousarray(F[:, j0:j1]), every, j0,
-               records, counts, failed)  # fmt: skip
-        Z[:, j0:j1] = z
-        RN[:, j0:j1] = Rn
+        z, Rn = _columns(Z, j0, j1), _columns(RN, j0, j1)
+        m = np.ascontiguousarray(problem.m[j0:j1])
+        _block(quat, problem, grid, z, Rn, _columns(problem.inv_I, j0, j1), m,
+               _columns(problem.F, j0, j1), every, j0, records, counts, failed)  # fmt: skip
+        for j in range(j1 - j0):
+            for c in range(z.shape[0]):
+                Z[j0 + j, c] = z[c, j]
+            for c in range(9):
+                RN[j0 + j, c // 3, c % 3] = Rn[c, j]
