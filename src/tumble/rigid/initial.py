@@ -103,6 +103,9 @@ def tolerances(body: RigidBody, Y: np.ndarray, span: float, rtol: float, atol) -
     return atol
 
 
+_IDENTITY = np.eye(3)
+
+
 def initial_attitude(R0, q0) -> np.ndarray:
     """R0 (checked to be a rotation; a single ``scipy.spatial.transform.Rotation`` is taken
     as its matrix) or R from q0 (normalised; zero norm refused)."""
@@ -121,7 +124,7 @@ def initial_attitude(R0, q0) -> np.ndarray:
         q = _checks.array("q0", q0, shape=(4,))
         return so3.matrix_from_quat(so3.quat_normalize(q, name="q0"))
     if R0 is None:
-        return np.eye(3)
+        return _IDENTITY.copy()  # a third of np.eye(3)'s cost
     R = _checks.array("R0", R0, shape=(3, 3))
     return so3.validate_rotation(R, name="R0", atol=1e-9)
 
