@@ -8,8 +8,8 @@ kernels are loaded from disk). Python's bytecode caches are read and written as 
 second run, does not compile tumble's sources again. The time is the first call
 alone (``import tumble`` and the case's other imports done before it, so it includes
 importing numba); the import time is given beside it. Prints medians (min–max) over fresh
-processes, wall-clock and CPU time (the CPU time of the process is steadier on a shared
-machine).
+processes, wall-clock and CPU time (the main thread's, where the first call runs: steadier
+than wall-clock time on a shared machine, and free of the idle spinning of OpenBLAS's threads).
 
 The baseline, run the same way: numba alone, the first call of a one-line cached function
 in a fresh process that has imported NumPy. It is what any first compiled call costs before
@@ -66,7 +66,7 @@ ONE_LINE = "from numba import njit\n\n\n@njit(cache=True)\ndef add_one(x):\n    
 
 PROGRAM = """
 import time
-clock = lambda: (time.perf_counter(), time.process_time())
+clock = lambda: (time.perf_counter(), time.thread_time())
 start = clock()
 {setup}
 imported = clock()
@@ -81,16 +81,16 @@ import time
 import numpy as np
 from tumble import RigidBody, simulate
 body = RigidBody(1.0, np.diag([1.0, 2.0, 3.0]))
-marks = [time.process_time()]
+marks = [time.thread_time()]
 import numba
-marks.append(time.process_time())
+marks.append(time.thread_time())
 import tumble.rigid.kernels
-marks.append(time.process_time())
+marks.append(time.thread_time())
 from numba.core.registry import cpu_target
 cpu_target.target_context.refresh()
-marks.append(time.process_time())
+marks.append(time.thread_time())
 simulate(body, 0.1, method='rkmk4', h=0.01, omega0=[0.1, 1.0, 0.05])
-marks.append(time.process_time())
+marks.append(time.thread_time())
 print(json.dumps([b - a for a, b in zip(marks, marks[1:])]))
 """
 PHASE_NAMES = (
@@ -171,7 +171,7 @@ def main(argv: list[str] | None = None) -> str:
         "version check, scipy.linalg for its BLAS check, which imports scipy's array-API "
         "layer and with it numpy.testing and numpy.f2py) and building numba's compiler "
         "context (its implementation registries, its extensions' entry points, its compiled "
-        f"runtime). tumble's own share of a warm first `simulate` is {share:.2f} s of CPU "
+        f"runtime). tumble's own share of a warm first `simulate` is {share:+.2f} s of CPU "
         "above that floor (the kernels module, one cached loop loaded): the target lies "
         "below numba's floor. The compiled solve's warm time is the compile of its loop for that right-hand side "
         "(numba cannot cache a function that receives another; the kernels it calls are "
