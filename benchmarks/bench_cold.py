@@ -173,9 +173,9 @@ def main(argv: list[str] | None = None) -> str:
         "context (its implementation registries, its extensions' entry points, its compiled "
         f"runtime). tumble's own share of a warm first `simulate` is {share:+.2f} s of CPU "
         "above that floor (the kernels module, one cached loop loaded): the target lies "
-        "below numba's floor. The compiled solve's warm time is the compile of its loop for that right-hand side "
-        "(numba cannot cache a function that receives another; the kernels it calls are "
-        f"cached). {machine()}.",
+        "below numba's floor. The compiled solve's warm time is the compile of its loop for "
+        "that right-hand side (numba cannot cache a function that receives another; the "
+        f"kernels it calls are cached). {machine()}.",
         "",
     ]
     markdown = "\n".join(sections)
