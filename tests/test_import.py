@@ -64,6 +64,15 @@ def test_the_heavy_dependencies_load_when_a_name_needs_them():
     assert "numba" in heavy_modules_after(run)
 
 
+def test_scipy_special_loads_only_where_the_elliptic_functions_need_it():
+    # 0.18 s of import: simulate and simulate_batch do not need it, the exact references do
+    loaded = "print('scipy.special' in sys.modules)"
+    names = "import sys\nfrom tumble import RigidBody, simulate, simulate_batch, exact\n"
+    period = "exact.free_body_period([1.0, 2.0, 3.0], [0.1, 1.0, 0.05])\n"
+    assert fresh(names + loaded).stdout.split() == ["False"]
+    assert fresh(names + period + loaded).stdout.split() == ["True"]
+
+
 def test_the_package_is_this_checkout():
     result = fresh("import tumble; print(tumble.__file__)")
     assert Path(result.stdout.strip()) == Path(tumble.__file__)

@@ -142,6 +142,22 @@ def _loads(off, zs, R, a, b, u0, u1, u2, problem, K, i):
         K[i, off + 8] += t2
 
 
+@njit(**_INLINE)
+def _copy(z, start, out):
+    """``out[:] = z[start:]`` as a loop: a slice assignment brings numba's broadcasting code
+    into every loop that records (160 kB of cached code to load instead of 20)."""
+    for q in range(out.shape[0]):
+        out[q] = z[start + q]
+
+
+@njit(**_INLINE)
+def _copy_matrix(M, out):
+    """``out[:, :] = M`` for 3×3 arrays, as a loop (see :func:`_copy`)."""
+    for r in range(3):
+        for c in range(3):
+            out[r, c] = M[r, c]
+
+
 # A chart's compiled twin is three functions: field(problem, zs, Rn, R, K, i) writes
 # K[i] = f(zs); advance(z, znew, Rn) sets z (and Rn) to the new state; record(z, Rn, R_out,
 # q_out, Y_out) writes one sample. ``problem`` is a :class:`Problem`.
@@ -196,8 +212,8 @@ def _no_first_same_as_last(K, s, znew):
 
 @njit(**_JIT)
 def _lie_record(z, Rn, R_out, q_out, Y_out):
-    R_out[:, :] = Rn
-    Y_out[:] = z[3:]
+    _copy_matrix(Rn, R_out)
+    _copy(z, 3, Y_out)
 
 
 @njit(**_INLINE)
@@ -235,8 +251,9 @@ def _quat_record(z, Rn, R_out, q_out, Y_out):
     """R of ``q/|q|``; ``q`` as it is (its norm error is the step's)."""
     norm = math.sqrt(z[0] ** 2 + z[1] ** 2 + z[2] ** 2 + z[3] ** 2)
     _quat_matrix(z[0] / norm, z[1] / norm, z[2] / norm, z[3] / norm, R_out)
-    q_out[:] = z[:4]
-    Y_out[:] = z[4:]
+    for q in range(4):
+        q_out[q] = z[q]
+    _copy(z, 4, Y_out)
 
 
 @njit(**_INLINE)
@@ -269,7 +286,7 @@ def _matrix_record(z, Rn, R_out, q_out, Y_out):
     for r in range(3):
         for c in range(3):
             R_out[r, c] = z[3 * r + c]
-    Y_out[:] = z[9:]
+    _copy(z, 9, Y_out)
 
 
 class Problem(NamedTuple):
@@ -960,7 +977,7 @@ def _split_record(z, Rp, P, R_out, Y_out):
     for r in range(3):
         for c in range(3):
             R_out[r, c] = Rp[r, 0] * P[c, 0] + Rp[r, 1] * P[c, 1] + Rp[r, 2] * P[c, 2]
-    Y_out[:] = z
+    _copy(z, 0, Y_out)
 
 
 def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
@@ -992,8 +1009,8 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
     for k in range(k0 + 1, k1 + 1):
         t_old = t_a + (k - 1) * h
         hk = (t_b if k == n else t_a + k * h) - t_old
-        saved[:] = z
-        R_saved[:, :] = Rn
+        _copy(z, 0, saved)
+        _copy_matrix(Rn, R_saved)
         owed_before = owed
         settle = until_record == 1 or k == k1  # this step's end is recorded or handed back
         converged = True
@@ -1018,8 +1035,8 @@ def _split_loop(problem, grid, z, Rn, k0, k1, every, step0, records):
             for c in range(3):
                 finite = finite and math.isfinite(Rn[r, c])
         if not (finite and converged):
-            z[:] = saved
-            Rn[:, :] = R_saved
+            _copy(saved, 0, z)
+            _copy_matrix(R_saved, Rn)
             if owed_before != 0.0:  # the state before: finish its last half turn
                 FLOW(Rn, z[6], z[7], z[8], problem.moments, 0.0, work, 0.0, owed_before)  # noqa: F821
             return count, k, NON_FINITE if not finite else UNCONVERGED
