@@ -42,15 +42,16 @@ log = logging.getLogger("tumble")
 def announce_compilation(kernel: Any, what: str) -> None:
     """Log, at INFO, that ``kernel``'s first call in this process will compile it.
 
-    A numba dispatcher with no signatures yet compiles on its first call: about 10 s the first
-    time after installation, then a fraction of a second to load it from numba's cache
+    A numba dispatcher with no signatures yet compiles on its first call: seconds the first
+    time after installation (1.8 s for ``simulate``'s loop, more for the batch loops), then a
+    fraction of a second to load it from numba's cache
     (``cache=True``). The command line shows the message as its status line. The test is
     the dispatcher's ``overloads`` dict, not ``signatures`` (which builds a list of types at
     every call: about 3 µs of a short run).
     """
     if not getattr(kernel, "overloads", True):
         log.info(
-            "preparing %s, compiled by numba (about 10 s the first time; later runs load it "
+            "preparing %s, compiled by numba (a few seconds the first time; later runs load it "
             "from its cache)",
             what,
         )
