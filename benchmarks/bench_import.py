@@ -31,9 +31,11 @@ PROGRAM = "import time\nstart = time.perf_counter()\n{}\nprint(time.perf_counter
 def import_time(statement: str) -> float:
     """Seconds ``statement`` takes in a fresh interpreter."""
     path = os.pathsep.join(filter(None, [str(SOURCE), os.environ.get("PYTHONPATH")]))
+    environment = {**os.environ, "PYTHONPATH": path}
+    environment.pop("PYTHONDONTWRITEBYTECODE", None)  # bytecode cached, as installed
     result = subprocess.run(
         [sys.executable, "-c", PROGRAM.format(statement)],
-        env={**os.environ, "PYTHONPATH": path},
+        env=environment,
         capture_output=True,
         text=True,
         check=True,
