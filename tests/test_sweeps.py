@@ -174,6 +174,9 @@ def test_samples_as_rows_columns_or_a_table_give_one_plan():
          r"be a row with keys \['h'\]"),
         ({"h": [0.01, float("nan")]}, r"grid key 'h', value nan: options.h = nan: must be a "
          r"finite number"),
+        # a long column of floats is checked at once: the bad value is still named
+        ({"omega0.1": np.r_[np.linspace(0.0, 1.0, 999), np.inf]}, r"grid key 'omega0.1', "
+         r"value inf: options.initial.omega0\[1\] = inf: must be a finite number"),
     ],
 )  # fmt: skip
 def test_bad_samples_are_refused(samples, message):

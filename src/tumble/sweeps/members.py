@@ -118,10 +118,12 @@ def run_members(plan: Plan, indices: list[tuple[int, ...]]) -> dict[str, np.ndar
         for k, values in enumerate(plan.values)
     ]
     shared = [k for k, path in enumerate(plan.paths) if path[0] != "initial"]
-    groups: dict[str, list[int]] = {}
-    for m in range(len(indices)):
-        key = json.dumps([columns[k][m] for k in shared])
-        groups.setdefault(key, []).append(m)
+    groups: dict[str, list[int]] = {"": list(range(len(indices)))}
+    if shared:  # members grouped by every option but the initial state
+        groups = {}
+        for m in range(len(indices)):
+            key = json.dumps([columns[k][m] for k in shared])
+            groups.setdefault(key, []).append(m)
     out = _allocate(plan, len(indices))
     for members in groups.values():
         start = clock.perf_counter()

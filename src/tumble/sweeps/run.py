@@ -97,7 +97,7 @@ def sweep(
     store : str or Path
         The Zarr store (a folder) to write.
     chunk : int, optional
-        Members per task (default: about 16 MB of output, at most 4096 members).
+        Members per task (default: about 16 MB of output, at most 16384 members).
     resume : bool
         Complete an existing store of the same sweep: members already done are skipped. An
         existing store without ``resume`` is refused.
