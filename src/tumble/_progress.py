@@ -47,7 +47,7 @@ def announce_compilation(kernel: Any, what: str) -> None:
     fraction of a second to load it from numba's cache
     (``cache=True``). The command line shows the message as its status line. The test is
     the dispatcher's ``overloads`` dict, not ``signatures`` (which builds a list of types at
-    every call: about 3 µs of a short run).
+    every call: 5.6 µs measured, a tenth of a short run).
     """
     if not getattr(kernel, "overloads", True):
         log.info(

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cache
 
 import numpy as np
 
@@ -120,16 +121,15 @@ def _stepper(
     ``f(t0, y0)`` through ``counted``, which checks its shape."""
     if not is_compiled(counted.fun):
         return RungeKutta(counted, tableau, t0, y)
-    if not _COMPILED:
-        from tumble.ode.compiled import CompiledRungeKutta  # imports numba: only now
-
-        _COMPILED.append(CompiledRungeKutta)
-    return _COMPILED[0](counted, counted.fun, tableau, t0, y, interpolants=interpolants)
+    return _compiled_stepper()(counted, counted.fun, tableau, t0, y, interpolants=interpolants)
 
 
-_COMPILED: list[Callable[..., RungeKutta]] = []
-""":class:`tumble.ode.compiled.CompiledRungeKutta` once imported (a second import statement
-costs a few µs of a short run)."""
+@cache
+def _compiled_stepper() -> Callable[..., RungeKutta]:
+    """:class:`tumble.ode.compiled.CompiledRungeKutta`, imported once (it imports numba)."""
+    from tumble.ode.compiled import CompiledRungeKutta
+
+    return CompiledRungeKutta
 
 
 _CONTROLLER = StepController()

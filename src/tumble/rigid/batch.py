@@ -459,8 +459,7 @@ def simulate_batch(
     conservative = [load for load in split_loads(forces)[0] if load.conservative]
     if conservative:  # V for every body and sample at once (mass broadcast over time)
         masses = _per_body(batch.bodies, lambda body: body.mass)[:, None]
-        with np.errstate(over="ignore", invalid="ignore"):
-            batch.potential_energy = potential_energy(conservative, batch.x, batch.R, masses)
+        batch.potential_energy = potential_energy(conservative, batch.x, batch.R, masses)
     return batch
 
 

@@ -274,11 +274,14 @@ def total_load(loads, t: float, state: State, mass: float) -> tuple[np.ndarray, 
 def potential_energy(loads, x: np.ndarray, R: np.ndarray, mass: float | np.ndarray) -> np.ndarray:
     """``V`` of the loads that have a potential, summed, at samples ``x`` (..., 3), ``R``
     (..., 3, 3); shape (...), J. Loads without one (:class:`Torque`, callables) add nothing.
-    ``mass`` may be an array that broadcasts against the leading axes (a batch's bodies)."""
+    ``mass`` may be an array that broadcasts against the leading axes (a batch's bodies).
+    A state that blew up gives inf or nan without a warning: the run's status reports it."""
     V = np.zeros(np.shape(x)[:-1])
-    for load in loads:
-        if load.conservative:
-            V = V + load.potential(x, R, mass)
+    conservative = [load for load in loads if load.conservative]
+    if conservative:  # numpy's error state only when there is work (a short run's µs)
+        with np.errstate(over="ignore", invalid="ignore"):
+            for load in conservative:
+                V = V + load.potential(x, R, mass)
     return V
 
 

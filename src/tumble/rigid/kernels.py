@@ -49,13 +49,28 @@ _C1, _C2, _C3, _C4, _C5 = -1.0 / 24, 1.0 / 720, -1.0 / 40320, 1.0 / 3628800, -1.
 
 
 @njit(**_JIT)
+def _exp_series(x):
+    """``(sin θ/θ, (1 − cos θ)/θ²)`` for ``θ² = x`` below :data:`SERIES_ANGLE`: Horner in
+    θ² of Σ (−θ²)^k/(2k+1)! and Σ (−θ²)^k/(2k+2)! (also the batch loops' vector form)."""
+    a = 1.0 + x * (_S1 + x * (_S2 + x * (_S3 + x * (_S4 + x * _S5))))
+    b = 0.5 + x * (_C1 + x * (_C2 + x * (_C3 + x * (_C4 + x * _C5))))
+    return a, b
+
+
+@njit(**_JIT)
+def _dexpinv_series(x):
+    """dexp⁻¹'s ``α`` for ``θ² = x`` below :data:`SERIES_ANGLE`: the Bernoulli series
+    ``1/12 + θ²/720 + …`` to 691/15!."""
+    tail = 1 / 1209600 + x * (1 / 47900160 + x * (691 / 1307674368000))
+    return 1 / 12 + x * (1 / 720 + x * (1 / 30240 + x * tail))
+
+
+@njit(**_JIT)
 def _exp_coefficients(theta2):
     """``(sin θ/θ, (1 − cos θ)/θ²)`` for ``θ² = theta2``."""
     x = theta2
-    if x < _SERIES2:  # Horner in θ²: Σ (−θ²)^k/(2k+1)! and Σ (−θ²)^k/(2k+2)!
-        a = 1.0 + x * (_S1 + x * (_S2 + x * (_S3 + x * (_S4 + x * _S5))))
-        b = 0.5 + x * (_C1 + x * (_C2 + x * (_C3 + x * (_C4 + x * _C5))))
-        return a, b
+    if x < _SERIES2:
+        return _exp_series(x)
     theta = math.sqrt(x)
     half = math.sin(0.5 * theta) / theta
     return math.sin(theta) / theta, 2.0 * half * half
@@ -66,8 +81,7 @@ def _dexpinv_coefficient(theta2):
     """``α = (1 − (θ/2) cot(θ/2))/θ²``; Bernoulli series ``1/12 + θ²/720 + …`` when small."""
     x = theta2
     if x < _SERIES2:
-        tail = 1 / 1209600 + x * (1 / 47900160 + x * (691 / 1307674368000))  # 691/15!
-        return 1 / 12 + x * (1 / 720 + x * (1 / 30240 + x * tail))
+        return _dexpinv_series(x)
     theta = math.sqrt(x)
     return 1.0 / x - (1.0 + math.cos(theta)) / (2.0 * theta * math.sin(theta))
 
@@ -251,8 +265,7 @@ def _quat_record(z, Rn, R_out, q_out, Y_out):
     """R of ``q/|q|``; ``q`` as it is (its norm error is the step's)."""
     norm = math.sqrt(z[0] ** 2 + z[1] ** 2 + z[2] ** 2 + z[3] ** 2)
     _quat_matrix(z[0] / norm, z[1] / norm, z[2] / norm, z[3] / norm, R_out)
-    for q in range(4):
-        q_out[q] = z[q]
+    _copy(z, 0, q_out)
     _copy(z, 4, Y_out)
 
 

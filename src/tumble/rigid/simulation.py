@@ -315,10 +315,7 @@ def simulate(
     sol = None
     if out.step_times is not None and out.interpolants is not None:
         sol = Solution(stepper, out.step_times, out.interpolants)
-    V = np.zeros(len(out.t))
-    if any(load.conservative for load in loads):
-        with np.errstate(over="ignore", invalid="ignore"):
-            V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
+    V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
     return Trajectory(
         t=out.t,
         x=Y_samples[:, :3],
@@ -359,8 +356,7 @@ def _about_pivot(body: RigidBody, t_end: float, pivot: ArrayLike, *, x0, v0, R0,
     run = simulate(reduced, t_end, x0=x_pivot, R0=R_start,
                    forces=pivot_forces(forces, body.mass, point, x_pivot), **options)  # fmt: skip
     x, v, L = centre_of_mass_motion(body, reduced, point, x_pivot, run.R, run.L_world)
-    with np.errstate(over="ignore", invalid="ignore"):
-        V = potential_energy(loads, x, run.R, body.mass)
+    V = potential_energy(loads, x, run.R, body.mass)
     settings = {**run.settings, "pivot": point.tolist()}
     return dataclasses.replace(run, x=x, v=v, L_world=L, body=body, settings=settings,
                                potential_energy=V)  # fmt: skip

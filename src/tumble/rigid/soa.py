@@ -39,44 +39,19 @@ import numpy as np
 from numba import njit, prange
 
 from tumble.rigid.kernels import (
-    _C1,
-    _C2,
-    _C3,
-    _C4,
-    _C5,
     _JIT,
-    _S1,
-    _S2,
-    _S3,
-    _S4,
-    _S5,
     _SERIES2,
     _cross,
     _dexpinv_coefficient,
+    _dexpinv_series,
     _exp_coefficients,
+    _exp_series,
     _quat_matrix,
     _rotate,
 )
 
 BLOCK = 256
 """Bodies marched together by one thread (their work arrays stay in the L2 cache)."""
-
-
-@njit(**_JIT)
-def _exp_series(x):
-    """exp's ``(a, b) = (sin θ/θ, (1 − cos θ)/θ²)`` for ``θ² = x`` from their series, as
-    :func:`~tumble.rigid.kernels._exp_coefficients` below :data:`SERIES_ANGLE`."""
-    a = 1.0 + x * (_S1 + x * (_S2 + x * (_S3 + x * (_S4 + x * _S5))))
-    b = 0.5 + x * (_C1 + x * (_C2 + x * (_C3 + x * (_C4 + x * _C5))))
-    return a, b
-
-
-@njit(**_JIT)
-def _dexpinv_series(x):
-    """dexp⁻¹'s ``α`` from its series, as :func:`~tumble.rigid.kernels._dexpinv_coefficient`
-    below :data:`SERIES_ANGLE`."""
-    tail = 1 / 1209600 + x * (1 / 47900160 + x * (691 / 1307674368000))
-    return 1 / 12 + x * (1 / 720 + x * (1 / 30240 + x * tail))
 
 
 @njit(**_JIT)

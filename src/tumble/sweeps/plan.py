@@ -332,9 +332,9 @@ def _check_column(key: str, path: tuple, values: list, options: dict, scenario: 
     """Check each distinct value; a column of numbers is checked by its extremes and type."""
     kinds = set(map(type, values))
     if kinds <= {int, float} and len(values) > 2:
-        floats = kinds == {float}  # checked at once; ints (finite) one by one, as before
-        if not floats or not np.isfinite(np.asarray(values, dtype=float)).all():
-            for value in values:  # the first non-finite one, named by the schema's message
+        # checked at once (ints are finite); a bad value is then named by the schema
+        if float in kinds and not np.isfinite(np.asarray(values, dtype=float)).all():
+            for value in values:
                 if not math.isfinite(value):
                     _check_value(key, path, value, options, scenario)
         _check_value(key, path, min(values), options, scenario)
