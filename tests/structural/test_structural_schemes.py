@@ -130,11 +130,13 @@ def test_step_increments_stay_accurate_on_a_very_fine_mesh(dt):
         fine = structural.cantilever(1.0, 10_000, tip_load=LOAD, **STEEL)
     reference = structural.integrate(coarse, "midpoint", dt, n_steps=150).tip_displacement
     tip = structural.integrate(fine, "midpoint", dt, n_steps=150, record_every=5)
-    # the plain seed form drifts by 190 % here; increments with element forces: 1.0e-5
-    # (the banded Cholesky from the tip; 4.0e-5 with SuperLU, compiled=False)
+    # κ(S) ≈ 1.6e17 at N = 10⁴, so κε ≈ 35: the result is round-off all the way down and its
+    # size depends on the CPU's BLAS kernels, not on tumble. Measured: the plain seed form
+    # drifts by 190 %; increments with element forces 1.0e-5 on an Intel Xeon, 3.8e-4 on an
+    # AMD EPYC (4.0e-4 with SuperLU, compiled=False; numba's generic target changes nothing).
+    # The portable claim is SPEC §3.7's: within 2e-3 where the plain form is 96-190 % off.
     deviation = np.abs(tip.tip_displacement - reference[np.rint(tip.t / dt).astype(int)]).max()
     assert deviation < 2e-3 * STATIC_TIP
-    assert deviation < 1e-4 * STATIC_TIP  # eliminated from the clamp instead: 4.2e-4
 
 
 def test_record_every_keeps_the_last_step(beam, dt):
