@@ -29,22 +29,22 @@ demo: $(STAMP)
 test: $(STAMP) browser
 	$(BIN)/python -m pytest
 
-# The round-off-sensitive tests again, on code paths this CPU does not take by default, so that a
-# tolerance that holds only for one CPU's arithmetic fails here and not on a user's machine:
-# numba compiled for a generic x86-64 (no SIMD, no FMA contraction: NUMBA_CPU_NAME=generic; its
-# cache keys on the CPU name, so the host's kernels stay cached beside these), then numpy with
-# every SIMD dispatch above its baseline turned off (AVX2/FMA3 and AVX-512 kernels: the features
-# numpy lists as dispatchable and finds on this CPU, in NPY_DISABLE_CPU_FEATURES). OpenBLAS's
-# own variables (OPENBLAS_CORETYPE, ...) are left as the machine sets them.
-PORTABILITY_TESTS ?= tests/ode tests/rigid tests/structural/test_structural_compiled.py \
-	tests/test_exact.py tests/test_so3.py tests/truth
+# The round-off-sensitive tests again, on arithmetic this CPU does not use by default, so that a
+# tolerance that holds for one CPU only fails here and not on a user's machine: numba compiled
+# for a generic x86-64 (no SIMD, no FMA: NUMBA_CPU_NAME=generic; its cache keys on the CPU name,
+# so the host's kernels stay cached beside these) and numpy with every SIMD dispatch above its
+# baseline turned off (the AVX2/FMA3 and AVX-512 kernels that numpy lists as dispatchable and
+# finds on this CPU, in NPY_DISABLE_CPU_FEATURES), both in one run to keep CI's time.
+# OpenBLAS's own variables (OPENBLAS_CORETYPE, ...) are left as the machine sets them.
+PORTABILITY_TESTS ?= tests/ode tests/rigid/test_rigid_kernels.py tests/rigid/test_rigid_batch.py \
+	tests/rigid/test_rigid_geometric.py tests/rigid/test_rigid_adaptive.py \
+	tests/structural/test_structural_compiled.py tests/test_exact.py tests/test_so3.py tests/truth
 NPY_DISPATCHED = $(BIN)/python -c "from numpy._core import _multiarray_umath as m; \
 	print(' '.join(f for f in m.__cpu_dispatch__ if m.__cpu_features__.get(f)))"
 
 portability: $(STAMP)
-	NUMBA_CPU_NAME=generic $(BIN)/python -m pytest -p no:cacheprovider $(PORTABILITY_TESTS)
-	NPY_DISABLE_CPU_FEATURES="$$($(NPY_DISPATCHED))" $(BIN)/python -m pytest \
-		-p no:cacheprovider $(PORTABILITY_TESTS)
+	NUMBA_CPU_NAME=generic NPY_DISABLE_CPU_FEATURES="$$($(NPY_DISPATCHED))" \
+		$(BIN)/python -m pytest -p no:cacheprovider $(PORTABILITY_TESTS)
 
 browser:
 	@command -v chromium >/dev/null && command -v chromedriver >/dev/null \
