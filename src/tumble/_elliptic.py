@@ -49,7 +49,7 @@ M1_MIN = 1e-300
 #: above it from the AGM. The AGM gives ``cn = cos(am)`` to an absolute ε, and on [0, K/2]
 #: ``cn ≥ cn(K/2) = √(k'/(1 + k'))`` (k' = √(1 − m)): its relative error is at most
 #: ``ε √((1 + k')/k')``, no more than 2ε from k' = 1/3 up. Below, the series (whose ratio
-#: of terms, the complementary nome, is at most 6.5e-3 there) keeps every function to a few ε.
+#: of terms, the complementary nome, is at most 7.4e-3 there) keeps every function to a few ε.
 M1_SERIES = 1.0 / 9.0
 #: Largest |I − Iᵀ| accepted for a full inertia tensor, relative to max |I|.
 SYMMETRIC_RTOL = 1e-10
@@ -117,7 +117,7 @@ def jacobi_series(w: np.ndarray, m: float, quarter: float, co_quarter: float) ->
     ``sn = (c/k) Σ (−1)ⁿ tanh c(w − 2nK)`` and ``cn = (c/k) Σ (−1)ⁿ sech c(w − 2nK)``, n over
     all integers. Each pair ±n is summed as one term (``tanh(a − b) + tanh(a + b) =
     sinh 2a/(cosh(a − b) cosh(a + b))``), and on [0, K/2] the pairs fall by the complementary
-    nome ``exp(−πK/K')`` at least (below 6.5e-3 for ``1 − m < M1_SERIES``): sn and cn keep
+    nome ``exp(−πK/K')`` at least (below 7.4e-3 for ``1 − m < M1_SERIES``): sn and cn keep
     a few ε relative.
     """
     c = 0.5 * np.pi / co_quarter
