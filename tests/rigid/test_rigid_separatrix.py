@@ -5,7 +5,7 @@ mpmath at 40 digits (:class:`Closed`), from ``mpmath.ellipfun``, ``ellipf``, ``e
 ``ellippi``; ``test_the_reference_agrees_with_dop853`` checks it where DOP853 can. Every
 tolerance comes from ulps: one step's own round-off (``step_bound``), or the problem's
 round-off floor, measured by turning the state by one ulp and propagating the turn with the
-reference (``floor``). Near the separatrix that floor is large, so the tests also count
+reference (``floored``). Near the separatrix that floor is large, so the tests also count
 flips, which round-off cannot change while the count's end lies a quarter period from any flip.
 """
 
