@@ -26,38 +26,54 @@ from numpy.typing import ArrayLike
 
 from tumble import _checks
 
+EPS = float(np.finfo(float).eps)
 #: The arithmetic–geometric mean stops when ``c_n ≤ AGM_TOL * a_n`` (one ulp: a and b can
 #: settle on neighbouring floats) or after AGM_MAX_STEPS (m1 = 1e-300 needs about 15).
-AGM_TOL = float(np.finfo(float).eps)
+AGM_TOL = EPS
 AGM_MAX_STEPS = 64
 #: Principal moments closer than this fraction of the largest count as equal (symmetric body).
 SYMMETRY_RTOL = 1e-12
-#: |Δ| below this fraction of its two terms counts as exactly on the separatrix.
-SEPARATRIX_RTOL = 1e-12
+#: The separatrix test, ``|x − y| ≤ SEPARATRIX_RTOL (x + y)`` with ``Δ = x² − y²``,
+#: ``x = √(C(C − B)) |ω_C|``, ``y = √(A(B − A)) |ω_A|``. Each of x and y is computed from the
+#: state with four roundings of at most u = ε/2 (the difference of moments, its product
+#: with a moment and the root, whose errors the root halves to u; ω = m/I; the product):
+#: ``|x̂ − x| ≤ 4u x = 2ε x``, and the same for y. So ``x̂ − ŷ`` is within ``2ε (x + y)`` of
+#: ``x − y``: below that bound the state's own terms do not fix the sign of Δ, the side of
+#: the separatrix it is on, and only there is its motion taken as the limit m = 1. Above
+#: it, ``1 − m`` is known to better than 100 % and the elliptic form is the state's motion.
+SEPARATRIX_RTOL = 2.0 * EPS
 #: 1 − m below this also counts as the separatrix (K = 347 there; Carlson's R_F overflows
 #: for subnormal arguments).
 M1_MIN = 1e-300
+#: Below this ``1 − m`` the Jacobi functions on [0, K/2] come from their hyperbolic series,
+#: above it from the AGM. The AGM gives ``cn = cos(am)`` to an absolute ε, and on [0, K/2]
+#: ``cn ≥ cn(K/2) = √(k'/(1 + k'))`` (k' = √(1 − m)): its relative error is at most
+#: ``ε √((1 + k')/k')``, no more than 2ε from k' = 1/3 up. Below, the series (whose ratio
+#: of terms, the complementary nome, is at most 7.4e-3 there) keeps every function to a few ε.
+M1_SERIES = 1.0 / 9.0
 #: Largest |I − Iᵀ| accepted for a full inertia tensor, relative to max |I|.
 SYMMETRIC_RTOL = 1e-10
 #: Largest |RᵀR − Id| accepted for an initial attitude.
 ROTATION_ATOL = 1e-10
 
 
-def incomplete_first(phi: np.ndarray, m1: float) -> np.ndarray:
-    """F(φ|m) = sin φ R_F(cos²φ, cos²φ + m1 sin²φ, 1) for |φ| ≤ π/2 (DLMF 19.25.5)."""
-    from scipy.special import elliprf  # 0.18 s to import: only where it is needed
+def legendre_integrals(
+    s: np.ndarray | float, c2: np.ndarray | float, d2: np.ndarray | float, nu: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """``F(φ|m)`` and ``Π(−ν; φ|m)`` for ``|φ| ≤ π/2`` from ``s ∝ sin φ``, ``c2 ∝ cos²φ`` and
+    ``d2 ∝ 1 − m sin²φ``, all scaled by one factor (``s² + c2`` is its square).
 
-    s, c = np.sin(phi), np.cos(phi)
-    return s * elliprf(c * c, c * c + m1 * s * s, 1.0)
+    DLMF 19.25.5 and 19.25.14 with R_F and R_J made homogeneous (``R_F(λx, λy, λz) =
+    R_F(x, y, z)/√λ``, ``R_J`` as ``λ^{-3/2}``): ``F = s R_F(c2, d2, r2)``, ``Π(n) = F + (n/3)
+    s³ R_J(c2, d2, r2, r2 − n s²)`` with ``r2 = s² + c2``. Taking cn² and dn² themselves, never
+    an angle, keeps the relative accuracy of a small cn or dn: the integrals' derivatives in
+    φ grow like 1/dn, those in cn² and dn² do not.
+    """
+    from scipy.special import elliprf, elliprj  # 0.18 s to import: only where it is needed
 
-
-def incomplete_third(n: float, phi: np.ndarray, m1: float) -> np.ndarray:
-    """Π(n; φ|m) = ∫₀^φ dθ / ((1 − n sin²θ) √(1 − m sin²θ)) for |φ| ≤ π/2 (DLMF 19.25.14)."""
-    from scipy.special import elliprf, elliprj
-
-    s, c = np.sin(phi), np.cos(phi)
-    y = c * c + m1 * s * s
-    return s * elliprf(c * c, y, 1.0) + n / 3.0 * s**3 * elliprj(c * c, y, 1.0, 1.0 - n * s * s)
+    r2 = s * s + c2
+    first = s * elliprf(c2, d2, r2)
+    return first, first - nu / 3.0 * s * s * s * elliprj(c2, d2, r2, r2 + nu * s * s)
 
 
 def complete_first(m1: float) -> float:
@@ -77,7 +93,9 @@ def complete_third(n: float, m1: float) -> float:
 def jacobi(u: np.ndarray, m: float, m1: float) -> tuple[np.ndarray, ...]:
     """sn, cn, dn and am of u by the arithmetic–geometric mean (A&S 16.4).
 
-    Accurate for |u| ≤ K(m); ``dn = √(cn² + m1 sn²)`` avoids the cancellation in 1 − m sn².
+    Accurate for |u| ≤ K(m) to an absolute ε; ``dn = √(cn² + m1 sn²)`` avoids the
+    cancellation in 1 − m sn². Near ``am = π/2`` a small cn is only as good as that absolute
+    ε (it is ``cos(am)``): :func:`jacobi_reduced` keeps its relative accuracy.
     """
     a, b, c = 1.0, np.sqrt(m1), np.sqrt(m)
     ratios: list[float] = []
@@ -89,6 +107,69 @@ def jacobi(u: np.ndarray, m: float, m1: float) -> tuple[np.ndarray, ...]:
         phi = 0.5 * (phi + np.arcsin(ratio * np.sin(phi)))
     sn, cn = np.sin(phi), np.cos(phi)
     return sn, cn, np.sqrt(cn * cn + m1 * sn * sn), phi
+
+
+def jacobi_series(w: np.ndarray, m: float, quarter: float, co_quarter: float) -> tuple:
+    """sn and cn of ``0 ≤ w ≤ K/2`` by their series of hyperbolic functions, for m near 1.
+
+    With ``c = π/(2K')``, ``K' = K(1 − m)`` (DLMF 22.11.1–2 for the complementary modulus,
+    carried over by Jacobi's imaginary transformation, DLMF 22.6(iv)):
+    ``sn = (c/k) Σ (−1)ⁿ tanh c(w − 2nK)`` and ``cn = (c/k) Σ (−1)ⁿ sech c(w − 2nK)``, n over
+    all integers. Each pair ±n is summed as one term (``tanh(a − b) + tanh(a + b) =
+    sinh 2a/(cosh(a − b) cosh(a + b))``), and on [0, K/2] the pairs fall by the complementary
+    nome ``exp(−πK/K')`` at least (below 7.4e-3 for ``1 − m < M1_SERIES``): sn and cn keep
+    a few ε relative.
+    """
+    c = 0.5 * np.pi / co_quarter
+    w = np.asarray(w, dtype=float)
+    sech, tanh, twice = 1.0 / np.cosh(c * w), np.tanh(c * w), np.sinh(2.0 * c * w)
+    cn, sn = sech.copy(), tanh.copy()
+    with np.errstate(over="ignore"):  # far terms overflow cosh to inf: they add 0
+        for n in range(1, AGM_MAX_STEPS):
+            near, far = np.cosh(c * (2 * n * quarter - w)), np.cosh(c * (2 * n * quarter + w))
+            sign = -1.0 if n % 2 else 1.0
+            cn += sign * (1.0 / near + 1.0 / far)
+            sn += sign * twice / (near * far)
+            if np.all(1.0 / near <= 0.25 * EPS * sech):
+                break
+    return c / np.sqrt(m) * sn, c / np.sqrt(m) * cn
+
+
+def jacobi_reduced(
+    r: np.ndarray, m: float, m1: float, quarter: float, co_quarter: float
+) -> tuple[np.ndarray, ...]:
+    """sn, cn, dn of ``|r| ≤ K``, each to a few ε *relative*: a small cn or dn keeps its
+    digits (the exact flow takes them into :func:`legendre_integrals`).
+
+    On ``|r| ≤ K/2`` directly, sn and cn by :func:`jacobi` where ``1 − m ≥ M1_SERIES``, else
+    by :func:`jacobi_series`; beyond, at ``v = K − |r|`` with ``sn(K − v) = cn v/dn v``,
+    ``cn(K − v) = k' sn v/dn v``, ``dn(K − v) = k'/dn v`` (DLMF 22.4.3), k' = √(1 − m). The
+    pair is scaled to ``sn² + cn² = 1`` and ``dn = √(cn² + m1 sn²)``: the three then keep
+    both identities to round-off, so the ω they give lies on the state's own energy and
+    momentum surfaces (without, the energy drifted by about an ulp a step).
+    """
+    r = np.asarray(r, dtype=float)
+    reflect = np.abs(r) > 0.5 * quarter
+    w = np.where(reflect, quarter - np.abs(r), np.abs(r))
+    if m1 >= M1_SERIES:
+        s, c, _, _ = jacobi(w, m, m1)
+    else:
+        s, c = jacobi_series(w, m, quarter, co_quarter)
+    size = np.hypot(s, c)
+    s, c = s / size, c / size
+    d = np.sqrt(c * c + m1 * s * s)
+    root = np.sqrt(m1)
+    sn = np.where(reflect, c / d, s)
+    cn = np.where(reflect, root * s / d, c)
+    dn = np.where(reflect, root / d, d)
+    return np.copysign(sn, r), cn, dn
+
+
+def precession_nu(moments: np.ndarray, pole: int) -> float:
+    """ν of the precession integral: ``C(B − A)/(A(C − B))`` in regime C (pole 2),
+    ``A(C − B)/(C(B − A))`` in regime A (pole 0)."""
+    a, b, c = moments
+    return c * (b - a) / (a * (c - b)) if pole == 2 else a * (c - b) / (c * (b - a))
 
 
 @dataclass(frozen=True)
@@ -109,6 +190,7 @@ class EllipticMotion:
     m: float
     m1: float
     u0: float
+    start: float  # Π(−ν; am u0 | m), taken with u0 from ω(0)'s own components
 
     @property
     def quarter(self) -> float:
@@ -120,17 +202,18 @@ class EllipticMotion:
         """Period of ω(t): 4K(m)/λ."""
         return 4.0 * self.quarter / self.rate
 
-    def reduce(self, t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """u(t) = 2K j + r with r in [−K, K); returns (r, j)."""
+    def functions(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
+        """sn, cn, dn of ``r`` and j, for u(t) = 2K j + r with r in [−K, K) (each function
+        to a few ε relative, :func:`jacobi_reduced`)."""
         k = self.quarter
         u = self.u0 + self.rate * t
         j = np.floor((u + k) / (2.0 * k))
-        return u - 2.0 * k * j, j
+        co_quarter = complete_first(self.m) if self.m1 < M1_SERIES else np.inf
+        return (*jacobi_reduced(u - 2.0 * k * j, self.m, self.m1, k, co_quarter), j)
 
     def omega(self, t: np.ndarray) -> np.ndarray:
         """ω(t) in the sorted principal frame, shape (n, 3)."""
-        r, j = self.reduce(t)
-        sn, cn, dn, _ = jacobi(r, self.m, self.m1)
+        sn, cn, dn, j = self.functions(t)
         flip = 1.0 - 2.0 * np.mod(j, 2.0)  # sn, cn change sign every 2K; dn does not
         out = np.empty((t.size, 3))
         out[:, 2 - self.pole] = self.amplitudes[2 - self.pole] * flip * cn
@@ -143,21 +226,17 @@ class EllipticMotion:
 
         φ̇ = |L| / I_pole ± |L| (C − A)/(A C) / (1 + ν sn²u), integrated with
         ∫ du / (1 + ν sn²u) = Π(−ν; am u | m); + and ν = C(B − A)/(A(C − B)) in regime C,
-        − and ν = A(C − B)/(C(B − A)) in regime A.
+        − and ν = A(C − B)/(C(B − A)) in regime A (:func:`precession_nu`). Π is taken from
+        sn, cn², dn² (:func:`legendre_integrals`), never from am, whose absolute error near
+        π/2 would be amplified by 1/dn.
         """
-        a, b, c = self.moments
-        if self.pole == 2:
-            nu, weight = c * (b - a) / (a * (c - b)), 1.0
-        else:
-            nu, weight = a * (c - b) / (c * (b - a)), -1.0
-        r, j = self.reduce(t)
-        r0, j0 = self.reduce(np.zeros(1))
-        am, am0 = jacobi(r, self.m, self.m1)[3], jacobi(r0, self.m, self.m1)[3]
-        full = 2.0 * complete_third(-nu, self.m1)
-        pi_t = incomplete_third(-nu, am, self.m1) + j * full
-        pi_0 = incomplete_third(-nu, am0, self.m1) + j0 * full
+        a, _, c = self.moments
+        nu, weight = precession_nu(self.moments, self.pole), (1.0 if self.pole == 2 else -1.0)
+        sn, cn, dn, j = self.functions(t)
+        pi_t = legendre_integrals(sn, cn * cn, dn * dn, nu)[1]
+        pi_t = pi_t + j * 2.0 * complete_third(-nu, self.m1)
         scale = weight * momentum * (c - a) / (a * c * self.rate)
-        return momentum * t / self.moments[self.pole] + scale * (pi_t - pi_0)
+        return momentum * t / self.moments[self.pole] + scale * (pi_t - self.start)
 
 
 def elliptic_motion(moments: np.ndarray, omega0: np.ndarray) -> EllipticMotion | None:
@@ -192,15 +271,25 @@ def elliptic_motion(moments: np.ndarray, omega0: np.ndarray) -> EllipticMotion |
     other = 2 - pole
     cn0 = omega0[other] / amplitudes[other] if amplitudes[other] > 0 else 1.0
     sn0 = sign * w_b / a_b if a_b > 0 else 0.0
-    return EllipticMotion(moments, amplitudes, pole, sign, rate, m, m1, _phase(cn0, sn0, m1))
+    u0, start = start_phase(sn0, cn0, m1, precession_nu(moments, pole))
+    return EllipticMotion(moments, amplitudes, pole, sign, rate, m, m1, u0, start)
 
 
-def _phase(cn0: float, sn0: float, m1: float) -> float:
-    """u0 with cn u0 = cn0, sn u0 = sn0, by u0 = F(am u0 | m) (+2K when cn0 < 0)."""
-    if cn0 >= 0.0:
-        return float(incomplete_first(np.arctan2(sn0, cn0), m1))
-    shift = 2.0 * complete_first(m1) * (1.0 if sn0 >= 0.0 else -1.0)
-    return float(incomplete_first(np.arctan2(-sn0, -cn0), m1)) + shift
+def start_phase(sn0: float, cn0: float, m1: float, nu: float) -> tuple[float, float]:
+    """``u0`` and ``Π(−ν; am u0 | m)`` for ``sn u0 = sn0``, ``cn u0 = cn0`` as read off ω(0).
+
+    :func:`legendre_integrals` of ``(sn0, cn0², cn0² + m1 sn0²)``: the components themselves,
+    so a small cn0 or dn0 (a spin near the middle axis) keeps its relative accuracy, where
+    ``atan2`` then ``cos`` would keep only an absolute ε and lose a factor 1/dn0 in u0. When
+    ``cn0 < 0`` the point is the half period on: ``u0 = ±2K + F``, ``Π = ±2Π(−ν|m) + Π``.
+    """
+    half = 0.0 if cn0 >= 0.0 else (1.0 if sn0 >= 0.0 else -1.0)
+    s, c = (sn0, cn0) if cn0 >= 0.0 else (-sn0, -cn0)
+    first, third = legendre_integrals(s, c * c, c * c + m1 * s * s, nu)
+    if half:
+        first = first + 2.0 * half * complete_first(m1)
+        third = third + 2.0 * half * complete_third(-nu, m1)
+    return float(first), float(third)
 
 
 @dataclass(frozen=True)
@@ -233,19 +322,22 @@ class SeparatrixMotion:
 
     def precession(self, t: np.ndarray, momentum: float) -> np.ndarray:
         a, b, c = self.moments
-        nu = c * (b - a) / (a * (c - b))
+        nu = precession_nu(self.moments, 2)
         root = np.sqrt(nu)
-
-        def integral(u):
-            return (u + root * np.arctan(root * np.tanh(u))) / (1.0 + nu)
-
-        u = self.u0 + self.rate * np.asarray(t, dtype=float)
+        t = np.asarray(t, dtype=float)
+        u = self.u0 + self.rate * t
+        turn = root * (np.arctan(root * np.tanh(u)) - np.arctan(root * np.tanh(self.u0)))
         scale = momentum * (c - a) / (a * c * self.rate)
-        return momentum * t / c + scale * (integral(u) - integral(self.u0))
+        return momentum * t / c + scale * (self.rate * t + turn) / (1.0 + nu)
 
 
 def separatrix_motion(moments: np.ndarray, omega0: np.ndarray) -> SeparatrixMotion:
-    """The motion from ω(0) on the separatrix (regime C's formulas at ``m = 1``)."""
+    """The motion from ω(0) on the separatrix (regime C's formulas at ``m = 1``).
+
+    ``u0 = asinh(tanh u0/sech u0)`` with ``sech u0`` from the small components themselves
+    (the mean square of ``|ω_A|/a_A`` and ``|ω_C|/a_C``, equal on the separatrix), not
+    ``atanh`` of a ``tanh u0`` near ±1, which would keep only its absolute ε.
+    """
     a, b, c = moments
     w_a, w_b, w_c = omega0
     s_p = np.hypot(np.sqrt(a * (c - a)) * w_a, np.sqrt(b * (c - b)) * w_b)
@@ -255,8 +347,18 @@ def separatrix_motion(moments: np.ndarray, omega0: np.ndarray) -> SeparatrixMoti
     sign = 1.0 if w_c >= 0.0 else -1.0
     side = 1.0 if w_a >= 0.0 else -1.0
     rate = s_q * np.sqrt((c - b) / (a * b * c))
-    tanh0 = np.clip(side * sign * w_b / amplitudes[1], -1.0, 1.0) if amplitudes[1] > 0 else 0.0
-    return SeparatrixMotion(moments, amplitudes, sign, side, rate, float(np.arctanh(tanh0)))
+    return SeparatrixMotion(moments, amplitudes, sign, side, rate,
+                            separatrix_phase(side * sign * w_b, w_a, w_c, amplitudes))  # fmt: skip
+
+
+def separatrix_phase(w_b: float, w_a: float, w_c: float, amplitudes: np.ndarray) -> float:
+    """``u0`` on the separatrix from ``tanh u0 = w_b/a_B`` and ``sech u0`` (see above)."""
+    a_a, a_b, a_c = amplitudes
+    cn0 = abs(w_a) / a_a if a_a > 0.0 else 0.0
+    dn0 = abs(w_c) / a_c if a_c > 0.0 else 0.0
+    tanh0 = w_b / a_b if a_b > 0.0 else 0.0
+    sech0 = np.sqrt(0.5 * (cn0 * cn0 + dn0 * dn0))
+    return float(np.arcsinh(tanh0 / sech0)) if sech0 > 0.0 else float(np.copysign(np.inf, tanh0))
 
 
 def flow_rotation(moments: np.ndarray, omega: np.ndarray, R0: np.ndarray, h: float) -> np.ndarray:

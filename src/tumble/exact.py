@@ -201,8 +201,9 @@ def free_body(inertia: ArrayLike, omega0: ArrayLike, t: ArrayLike) -> np.ndarray
     Raises
     ------
     ValueError
-        On bad input, or ω0 on the separatrix ‖L‖² = 2EB (relative tolerance 1e-12) and not
-        a steady spin: the motion takes infinite time to leave the middle axis (m = 1).
+        On bad input, or ω0 on the separatrix ‖L‖² = 2EB and not a steady spin: the motion
+        takes infinite time to leave the middle axis (m = 1). On it means within the round-off
+        of ω0's own terms: ``|x − y| ≤ 2ε (x + y)`` for ``Δ = x² − y²`` (docs/exact.md).
 
     References
     ----------

@@ -34,14 +34,19 @@ and ``R_p m = L`` stays constant. Every flow below turns ``R_p`` by an exact rot
     The exact flow: ω(t) by Jacobi's elliptic functions and R(t) by the closed form of
     :func:`tumble.exact.free_body_rotation` (Landau–Lifshitz §37; Celledoni, Fassò, Säfström
     and Zanna 2008), evaluated afresh from each step's state, so its error is round-off
-    whatever h. The elliptic parameter's complement ``1 − m`` is formed without cancellation,
-    which keeps the functions accurate to round-off up to the separatrix ``m → 1``; on the
-    separatrix itself (``|L|² = 2EB`` to 1e-12), where the elliptic form has an infinite
-    period, the step uses its limit ``sn → tanh``, ``cn, dn → sech``. The two agree to
-    round-off where they meet (``tests/rigid``): the switch happens where the state itself
-    cannot tell which side of the separatrix it is on. Each step ends with one Newton step
-    to the polar factor, ``R ← R (3 − RᵀR)/2``: the closed form's round-off otherwise
-    grows ``det R`` by about 1.6e-16 a step, a secular energy drift.
+    whatever h. The elliptic parameter's complement ``1 − m`` is formed without cancellation;
+    the phase and the precession integral are taken from sn, cn² and dn² themselves (never
+    through an angle, which near the middle axis keeps a small cn only to an absolute ε),
+    and Jacobi's functions keep each of sn, cn, dn to a few ε relative: so a step is
+    accurate to its round-off up to the separatrix ``m → 1``. Only where the state cannot
+    tell which side of the separatrix it is on, ``|x − y| ≤ 2ε (x + y)`` for
+    ``Δ = |L|² − 2EB = x² − y²`` (the round-off of x and y,
+    :data:`tumble._elliptic.SEPARATRIX_RTOL`), does the step use the limit ``sn → tanh``,
+    ``cn, dn → sech``, where the elliptic form's period is infinite. Over many steps the
+    error is the problem's own round-off floor (an ulp of the state, propagated), which
+    near the separatrix is large; docs/geometric.md has the measurements. Each step ends
+    with one Newton step to the polar factor, ``R ← R (3 − RᵀR)/2``: the closed form's
+    round-off otherwise grows ``det R`` by about 1.6e-16 a step, a secular energy drift.
 
 The two implicit flows are solved by Newton's method (a 3 × 3 system) to round-off, at most
 :data:`NEWTON_MAX` iterations; when that does not converge the step fails with

@@ -699,16 +699,18 @@ def _dmv_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
     return converged
 
 
-# The exact flow: Carlson's symmetric integrals, Jacobi's functions by the AGM, and the
-# closed form of tumble._elliptic (which this mirrors line by line, one time at a time).
+# The exact flow: Carlson's symmetric integrals, Jacobi's functions by the AGM or their
+# hyperbolic series, and the closed form of tumble._elliptic (which this mirrors line by
+# line, one time at a time).
 
 _EPS = 2.220446049250313e-16
 _RF_Q = (3.0 * _EPS) ** (-1.0 / 6.0)
 _RJ_Q = (0.25 * _EPS) ** (-1.0 / 6.0)
-SYMMETRY_RTOL, SEPARATRIX_RTOL, M1_MIN, AGM_MAX_STEPS = 1e-12, 1e-12, 1e-300, 64
-"""As :mod:`tumble._elliptic` (a test checks they agree)."""
-WORK_SIZE = AGM_MAX_STEPS + 8
-"""A flow's work array: the AGM's ratios, then ω at 0 and h (6), then Π at 0 and h (2)."""
+SYMMETRY_RTOL, SEPARATRIX_RTOL, M1_MIN, M1_SERIES = 1e-12, 2.0 * _EPS, 1e-300, 1.0 / 9.0
+"""As :mod:`tumble._elliptic`, which derives them (a test checks they agree)."""
+AGM_MAX_STEPS = 64
+WORK_SIZE = AGM_MAX_STEPS
+"""A flow's work array: the AGM's ratios."""
 
 
 @njit(**_JIT)
@@ -786,12 +788,90 @@ def _jacobi(u, m, m1, work):
 
 
 @njit(**_JIT)
-def _third(n, phi, m1):
-    """``Π(n; φ|m)`` for ``|φ| ≤ π/2`` (DLMF 19.25.14)."""
-    s, c = math.sin(phi), math.cos(phi)
-    y = c * c + m1 * s * s
-    third = _carlson_rj(c * c, y, 1.0, 1.0 - n * s * s)
-    return s * _carlson_rf(c * c, y, 1.0) + n / 3.0 * s**3 * third
+def _jacobi_series(w, m, quarter, co_quarter):
+    """``(sn, cn)`` of ``0 ≤ w ≤ K/2`` by their hyperbolic series
+    (``tumble._elliptic.jacobi_series``)."""
+    c = 0.5 * math.pi / co_quarter
+    sech, tanh, twice = 1.0 / math.cosh(c * w), math.tanh(c * w), math.sinh(2.0 * c * w)
+    cn, sn = sech, tanh
+    for n in range(1, AGM_MAX_STEPS):
+        near, far = math.cosh(c * (2 * n * quarter - w)), math.cosh(c * (2 * n * quarter + w))
+        sign = -1.0 if n % 2 else 1.0
+        cn += sign * (1.0 / near + 1.0 / far)
+        sn += sign * twice / (near * far)
+        if 1.0 / near <= 0.25 * _EPS * sech:
+            break
+    return c / math.sqrt(m) * sn, c / math.sqrt(m) * cn
+
+
+@njit(**_JIT)
+def _jacobi_reduced(r, m, m1, quarter, co_quarter, work):
+    """``(sn, cn, dn)`` of ``|r| ≤ K``, each to a few ε relative and together on both
+    identities (``tumble._elliptic.jacobi_reduced``: beyond K/2 by the reflection about K)."""
+    w = abs(r)
+    reflect = w > 0.5 * quarter
+    if reflect:
+        w = quarter - w
+    if m1 >= M1_SERIES:
+        s, c, _, _ = _jacobi(w, m, m1, work)
+    else:
+        s, c = _jacobi_series(w, m, quarter, co_quarter)
+    size = math.hypot(s, c)
+    s, c = s / size, c / size
+    d = math.sqrt(c * c + m1 * s * s)
+    if reflect:
+        root = math.sqrt(m1)
+        s, c, d = c / d, root * s / d, root / d
+    return math.copysign(s, r), c, d
+
+
+@njit(**_JIT)
+def _legendre_integrals(s, c2, d2, nu):
+    """``(F(φ|m), Π(−ν; φ|m))`` from ``s, cn², dn²`` (``tumble._elliptic.legendre_integrals``)."""
+    r2 = s * s + c2
+    first = s * _carlson_rf(c2, d2, r2)
+    return first, first - nu / 3.0 * s * s * s * _carlson_rj(c2, d2, r2, r2 + nu * s * s)
+
+
+@njit(**_JIT)
+def _elliptic_step(wb, other_w, pole_w, amplitudes, pole, rate, m, m_1, nu, h, work):
+    """The elliptic motion from ω over ``h``: ``(ω_other, ω_B, ω_pole)`` at ``h`` and the
+    precession integral ``Π(−ν; am u(h)) − Π(−ν; am u0)`` (``tumble._elliptic``'s
+    ``elliptic_motion``, ``start_phase``, ``EllipticMotion.omega`` and ``precession``)."""
+    amp_other, amp_b, amp_pole = amplitudes
+    sign = 1.0 if pole_w > 0.0 else -1.0
+    cn0 = other_w / amp_other if amp_other > 0.0 else 1.0
+    sn0 = sign * wb / amp_b if amp_b > 0.0 else 0.0
+    quarter = _carlson_rf(0.0, m_1, 1.0)
+    full = 2.0 * (quarter - nu / 3.0 * _carlson_rj(0.0, m_1, 1.0, 1.0 + nu))  # 2Π(−ν|m)
+    half = 0.0 if cn0 >= 0.0 else (1.0 if sn0 >= 0.0 else -1.0)
+    s, c = (sn0, cn0) if cn0 >= 0.0 else (-sn0, -cn0)
+    u0, start = _legendre_integrals(s, c * c, c * c + m_1 * s * s, nu)
+    u0, start = u0 + 2.0 * half * quarter, start + half * full
+    co_quarter = _carlson_rf(0.0, m, 1.0) if m_1 < M1_SERIES else math.inf
+    u = u0 + rate * h
+    j = math.floor((u + quarter) / (2.0 * quarter))
+    sn, cn, dn = _jacobi_reduced(u - 2.0 * quarter * j, m, m_1, quarter, co_quarter, work)
+    flip = 1.0 - 2.0 * (j - 2.0 * math.floor(0.5 * j))
+    third = _legendre_integrals(sn, cn * cn, dn * dn, nu)[1] + j * full
+    return amp_other * flip * cn, sign * amp_b * flip * sn, sign * amp_pole * dn, third - start
+
+
+@njit(**_JIT)
+def _separatrix_step(wa, wb, wc, amp_a, amp_b, amp_c, rate, nu, h):
+    """The motion at ``m = 1`` over ``h`` (``tumble._elliptic.SeparatrixMotion``):
+    ``(ω_A, ω_B, ω_C)`` at ``h`` and ``∫ du/(1 + ν tanh²u)`` over the step."""
+    sign, side = (1.0 if wc >= 0.0 else -1.0), (1.0 if wa >= 0.0 else -1.0)
+    cn0 = abs(wa) / amp_a if amp_a > 0.0 else 0.0
+    dn0 = abs(wc) / amp_c if amp_c > 0.0 else 0.0
+    tanh0 = side * sign * wb / amp_b if amp_b > 0.0 else 0.0
+    sech0 = math.sqrt(0.5 * (cn0 * cn0 + dn0 * dn0))
+    u0 = math.asinh(tanh0 / sech0) if sech0 > 0.0 else math.copysign(math.inf, tanh0)
+    u = u0 + rate * h
+    sech, tanh, root = 1.0 / math.cosh(u), math.tanh(u), math.sqrt(nu)
+    turn = root * (math.atan(root * tanh) - math.atan(root * math.tanh(u0)))
+    return (side * amp_a * sech, side * sign * amp_b * tanh, sign * amp_c * sech,
+            (rate * h + turn) / (1.0 + nu))  # fmt: skip
 
 
 @njit(**_JIT)
@@ -875,7 +955,7 @@ def _exact_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
                                                    Rp[0, c], Rp[1, c], Rp[2, c])  # fmt: skip
         _turn(Rp, 0.0, 0.0, 0.0, s, rate * h)
         return True
-    # the asymmetric body (tumble._elliptic.elliptic_motion)
+    # the asymmetric body (tumble._elliptic.elliptic_motion; SEPARATRIX_RTOL says the test)
     s_p = math.hypot(math.sqrt(A * (C - A)) * wa, math.sqrt(B * (C - B)) * wb)
     s_q = math.hypot(math.sqrt(B * (B - A)) * wb, math.sqrt(C * (C - A)) * wc)
     x, y = math.sqrt(C * (C - B)) * abs(wc), math.sqrt(A * (B - A)) * abs(wa)
@@ -891,67 +971,33 @@ def _exact_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
         rate = s_p * math.sqrt((B - A) / (A * B * C))
         m = (C - B) / (B - A) * (s_q / s_p) ** 2
         m_1 = (C - A) / (B - A) * ((y - x) / s_p) * ((y + x) / s_p)
-    separatrix = separatrix or not m_1 >= M1_MIN
-    norm = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+    if not (separatrix or m_1 >= M1_MIN):  # m = 1 in double precision: regime C's limit
+        separatrix, pole, amp_b = True, 2, s_p / math.sqrt(B * (C - B))
+        rate = s_q * math.sqrt((C - B) / (A * B * C))
     if pole == 2:
         nu, weight = C * (B - A) / (A * (C - B)), 1.0
     else:
         nu, weight = A * (C - B) / (C * (B - A)), -1.0
-    scale = weight * norm * (C - A) / (A * C * rate)
     if separatrix:  # tumble._elliptic.SeparatrixMotion (regime C at m = 1)
-        sign, side = (1.0 if wc >= 0.0 else -1.0), (1.0 if wa >= 0.0 else -1.0)
-        tanh0 = min(1.0, max(-1.0, side * sign * wb / amp_b)) if amp_b > 0.0 else 0.0
-        u0 = math.atanh(tanh0)
-        root = math.sqrt(nu)
-        o = work[AGM_MAX_STEPS : AGM_MAX_STEPS + 6]  # ω at 0 and h
-        for k in range(2):
-            u = u0 + rate * h * k
-            sech, tanh = 1.0 / math.cosh(u), math.tanh(u)
-            o[3 * k] = side * amp_a * sech
-            o[3 * k + 1] = side * sign * amp_b * tanh
-            o[3 * k + 2] = sign * amp_c * sech
-        u = u0 + rate * h
-        integral = ((u + root * math.atan(root * math.tanh(u)))
-                    - (u0 + root * math.atan(root * math.tanh(u0)))) / (1.0 + nu)  # fmt: skip
-        phi = norm * h / C + scale * integral
+        e0, e1, e2, integral = _separatrix_step(wa, wb, wc, amp_a, amp_b, amp_c, rate, nu, h)
+    elif pole == 2:
+        e0, e1, e2, integral = _elliptic_step(
+            wb, wa, wc, (amp_a, amp_b, amp_c), pole, rate, m, m_1, nu, h, work
+        )
     else:
-        sign = 1.0 if (wc if pole == 2 else wa) > 0.0 else -1.0
-        other_w, other_amp = (wa, amp_a) if pole == 2 else (wc, amp_c)
-        cn0 = other_w / other_amp if other_amp > 0.0 else 1.0
-        sn0 = sign * wb / amp_b if amp_b > 0.0 else 0.0
-        quarter = _carlson_rf(0.0, m_1, 1.0)
-        if cn0 >= 0.0:
-            ang = math.atan2(sn0, cn0)
-            u0 = math.sin(ang) * _carlson_rf(math.cos(ang) ** 2, math.cos(ang) ** 2
-                                             + m_1 * math.sin(ang) ** 2, 1.0)  # fmt: skip
-        else:
-            ang = math.atan2(-sn0, -cn0)
-            u0 = math.sin(ang) * _carlson_rf(math.cos(ang) ** 2, math.cos(ang) ** 2
-                                             + m_1 * math.sin(ang) ** 2, 1.0)  # fmt: skip
-            u0 += 2.0 * quarter * (1.0 if sn0 >= 0.0 else -1.0)
-        n = -nu
-        full = 2.0 * (quarter + n / 3.0 * _carlson_rj(0.0, m_1, 1.0, 1.0 - n))
-        o = work[AGM_MAX_STEPS : AGM_MAX_STEPS + 6]
-        pis = work[AGM_MAX_STEPS + 6 : AGM_MAX_STEPS + 8]
-        for k in range(2):
-            u = u0 + rate * h * k
-            j = math.floor((u + quarter) / (2.0 * quarter))
-            r = u - 2.0 * quarter * j
-            sn, cn, dn, am = _jacobi(r, m, m_1, work)
-            flip = 1.0 - 2.0 * (j - 2.0 * math.floor(0.5 * j))
-            o[3 * k + 2 - pole] = (amp_a if pole == 2 else amp_c) * flip * cn
-            o[3 * k + 1] = sign * amp_b * flip * sn
-            o[3 * k + pole] = sign * (amp_c if pole == 2 else amp_a) * dn
-            pis[k] = _third(n, am, m_1) + j * full
-        phi = norm * h / moments[pole] + scale * (pis[1] - pis[0])
+        e2, e1, e0, integral = _elliptic_step(
+            wb, wc, wa, (amp_c, amp_b, amp_a), pole, rate, m, m_1, nu, h, work
+        )
+    norm = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+    phi = norm * h / moments[pole] + weight * norm * (C - A) / (A * C * rate) * integral
     # l = I ω / |L| in the pole frame's order (q, r, p)
     if pole == 2:
         i0, i1, i2 = 0, 1, 2
     else:
         i0, i1, i2 = 1, 2, 0
-    o = work[AGM_MAX_STEPS : AGM_MAX_STEPS + 6]
+    e = (e0, e1, e2)  # ω at h
     p0, p1, p2 = (m0, m1, m2)[i0], (m0, m1, m2)[i1], (m0, m1, m2)[i2]  # the state's own m
-    q0, q1, q2 = moments[i0] * o[3 + i0], moments[i1] * o[3 + i1], moments[i2] * o[3 + i2]
+    q0, q1, q2 = moments[i0] * e[i0], moments[i1] * e[i1], moments[i2] * e[i2]
     size_p = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)  # unit l: M(l) orthogonal to round-off
     size_q = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
     _times_permuted(
