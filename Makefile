@@ -37,7 +37,7 @@ test: $(STAMP) browser
 # finds on this CPU, in NPY_DISABLE_CPU_FEATURES), both in one run to keep CI's time.
 # OpenBLAS's own variables (OPENBLAS_CORETYPE, ...) are left as the machine sets them.
 PORTABILITY_TESTS ?= tests/ode tests/rigid/test_rigid_kernels.py tests/rigid/test_rigid_batch.py \
-	tests/rigid/test_rigid_geometric.py tests/rigid/test_rigid_adaptive.py \
+	tests/rigid/test_rigid_geometric.py tests/rigid/test_rigid_adaptive.py tests/rigid/test_rigid_separatrix.py \
 	tests/structural/test_structural_compiled.py tests/test_exact.py tests/test_so3.py tests/truth
 NPY_DISPATCHED = $(BIN)/python -c "from numpy._core import _multiarray_umath as m; \
 	print(' '.join(f for f in m.__cpu_dispatch__ if m.__cpu_features__.get(f)))"
