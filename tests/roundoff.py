@@ -1,0 +1,53 @@
+"""Round-off bounds for the tests: derived from the computation, never from one CPU.
+
+Which results may differ between machines:
+
+- numpy's ``@``, ``dot`` and ``linalg`` call BLAS and LAPACK, whose kernels (their order of
+  summation, their use of FMA) are chosen for the CPU at run time;
+- numpy's ``sin``, ``cos``, ``exp``, ``arctan2``… dispatch to SIMD loops (AVX2, AVX-512) that
+  differ from libm, and from each other, by an ulp or two;
+- numba compiles without fastmath: no FMA contraction and no reassociation, so its scalar code
+  performs the same IEEE operations on every x86-64 (``NUMBA_CPU_NAME=generic`` gives the same
+  bits), except in a kernel that asks for ``fastmath={"contract"}``; the same compiled function
+  called twice on the same inputs gives the same bits everywhere.
+
+A sum of n terms ``x_i``, in any order, with or without FMA, lies within ``γ_n Σ|x_i|`` of the
+exact sum, ``γ_n = n u / (1 − n u)`` with ``u = eps / 2`` (Higham, *Accuracy and Stability of
+Numerical Algorithms*, 2nd ed., 2002, §3.1). Two evaluations therefore differ by at most
+``n eps Σ|x_i|``: :func:`sum_bound`. A run of N steps, each rounding terms of magnitude S in
+at most n operations, whose flow amplifies a perturbation by at most κ, ends within
+``κ N n eps S`` of the same run in exact arithmetic: :func:`run_bound`.
+"""
+
+import numpy as np
+
+EPS = float(np.finfo(float).eps)
+"""The spacing of doubles at 1, 2⁻⁵² (twice the unit round-off u)."""
+
+
+def sum_bound(magnitude, operations: int):
+    """How far two evaluations of one sum may differ, on any IEEE-754 machine.
+
+    Parameters
+    ----------
+    magnitude : float or ndarray
+        ``Σ|x_i|``, the sum of the magnitudes of the terms (elementwise for an array).
+    operations : int
+        The roundings along the longest chain of the evaluation (``n`` terms: ``n``).
+
+    Returns
+    -------
+    float or ndarray
+        ``operations · eps · magnitude`` (each evaluation lies within half of it of the exact
+        sum).
+    """
+    return operations * EPS * np.asarray(magnitude, dtype=float)
+
+
+def run_bound(steps: int, operations: int, magnitude, condition: float = 1.0):
+    """How far two runs of ``steps`` steps that round differently may end apart.
+
+    Each step is a :func:`sum_bound` of ``operations`` roundings on terms of ``magnitude``, and
+    the flow amplifies each step's difference by at most ``condition`` (κ) by the run's end.
+    """
+    return condition * steps * sum_bound(magnitude, operations)
