@@ -13,16 +13,26 @@ Which results may differ between machines:
 
 A sum of n terms ``x_i``, in any order, with or without FMA, lies within ``γ_n Σ|x_i|`` of the
 exact sum, ``γ_n = n u / (1 − n u)`` with ``u = eps / 2`` (Higham, *Accuracy and Stability of
-Numerical Algorithms*, 2nd ed., 2002, §3.1). Two evaluations therefore differ by at most
-``n eps Σ|x_i|``: :func:`sum_bound`. A run of N steps, each rounding terms of magnitude S in
-at most n operations, whose flow amplifies a perturbation by at most κ, ends within
-``κ N n eps S`` of the same run in exact arithmetic: :func:`run_bound`.
+Numerical Algorithms*, 2nd ed., 2002, §3.1); more generally, a result computed in a chain of
+at most n roundings lies within about ``n u Σ|terms|`` of its exact value: :func:`error_bound`.
+Two evaluations therefore differ by at most ``n eps Σ|x_i|``: :func:`sum_bound`. A run of N
+steps, each rounding terms of magnitude S in at most n operations, whose flow amplifies a
+perturbation by at most κ, ends within ``κ N n eps S`` of the same run rounded otherwise:
+:func:`run_bound`.
 """
 
 import numpy as np
 
 EPS = float(np.finfo(float).eps)
 """The spacing of doubles at 1, 2⁻⁵² (twice the unit round-off u)."""
+
+
+def error_bound(magnitude, operations: int):
+    """How far one evaluation may lie from the exact value, on any IEEE-754 machine:
+    ``operations · u · magnitude`` (``u = eps / 2``), for ``operations`` roundings along the
+    longest chain of the evaluation (inputs rounded to doubles count one each) on terms whose
+    magnitudes add to ``magnitude``."""
+    return operations * (EPS / 2) * np.asarray(magnitude, dtype=float)
 
 
 def sum_bound(magnitude, operations: int):
@@ -41,7 +51,7 @@ def sum_bound(magnitude, operations: int):
         ``operations · eps · magnitude`` (each evaluation lies within half of it of the exact
         sum).
     """
-    return operations * EPS * np.asarray(magnitude, dtype=float)
+    return 2 * error_bound(magnitude, operations)
 
 
 def run_bound(steps: int, operations: int, magnitude, condition: float = 1.0):
