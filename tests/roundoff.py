@@ -19,6 +19,14 @@ Two evaluations therefore differ by at most ``n eps Σ|x_i|``: :func:`sum_bound`
 steps, each rounding terms of magnitude S in at most n operations, whose flow amplifies a
 perturbation by at most κ, ends within ``κ N n eps S`` of the same run rounded otherwise:
 :func:`run_bound`.
+
+Over long runs that worst case, every rounding the largest possible and all of one sign, is
+far from what happens and too loose to test anything. Roundings behave as independent
+random errors of mean zero and at most ``u |x|`` each; then a chain of n of them stays within
+``λ √n u Σ|x|`` with probability at least ``1 − 2n exp(−λ²(1 − u)²/2)`` (Higham and Mary,
+"A new approach to probabilistic rounding error analysis", SIAM J. Sci. Comput. 41(5),
+A2815–A2835, 2019, Theorem 2.4): :func:`walk_bound`, with λ chosen for a failure probability
+of 1e-6.
 """
 
 import numpy as np
@@ -27,7 +35,7 @@ EPS = float(np.finfo(float).eps)
 """The spacing of doubles at 1, 2⁻⁵² (twice the unit round-off u)."""
 
 
-def error_bound(magnitude, operations: int):
+def error_bound(magnitude, operations: float):
     """How far one evaluation may lie from the exact value, on any IEEE-754 machine:
     ``operations · u · magnitude`` (``u = eps / 2``), for ``operations`` roundings along the
     longest chain of the evaluation (inputs rounded to doubles count one each) on terms whose
@@ -61,3 +69,15 @@ def run_bound(steps: int, operations: int, magnitude, condition: float = 1.0):
     the flow amplifies each step's difference by at most ``condition`` (κ) by the run's end.
     """
     return condition * steps * sum_bound(magnitude, operations)
+
+
+def walk_bound(steps: int, operations: int, magnitude, condition: float = 1.0):
+    """How far two runs that round differently may drift apart, with probability 1 − 1e-6.
+
+    Each run's ``steps × operations`` roundings on terms of ``magnitude`` random-walk
+    (module docstring): ``λ √(N n) u S`` with ``2 N n exp(−λ²/2) = 1e-6``; twice that for
+    the two runs, grown at most ``condition`` (κ) by the end.
+    """
+    n = steps * operations
+    sigmas = np.sqrt(2 * np.log(2 * n / 1e-6))
+    return condition * 2 * error_bound(magnitude, sigmas * np.sqrt(n))
