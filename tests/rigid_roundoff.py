@@ -1,5 +1,5 @@
 """How deep a rigid-body step's round-off goes: the bounds of the kernel-against-reference
-tests (tests/roundoff.py has the model).
+tests and of the invariants a run keeps to round-off (tests/roundoff.py has the model).
 
 The NumPy reference multiplies 3 × 3 matrices in the CPU's BLAS kernel and takes sin, cos and
 norms from numpy's SIMD loops; the numba kernel writes the same formulas out in its own order.

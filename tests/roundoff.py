@@ -5,7 +5,7 @@ Which results may differ between machines:
 - numpy's ``@``, ``dot`` and ``linalg`` call BLAS and LAPACK, whose kernels (their order of
   summation, their use of FMA) are chosen for the CPU at run time;
 - numpy's ``sin``, ``cos``, ``exp``, ``arctan2``… dispatch to SIMD loops (AVX2, AVX-512) that
-  differ from libm, and from each other, by an ulp or two;
+  differ from libm, and from each other, by a few ulps (at most 4);
 - numba compiles without fastmath: no FMA contraction and no reassociation, so its scalar code
   performs the same IEEE operations on every x86-64 (``NUMBA_CPU_NAME=generic`` gives the same
   bits), except in a kernel that asks for ``fastmath={"contract"}``; the same compiled function
