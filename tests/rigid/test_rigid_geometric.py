@@ -182,6 +182,8 @@ def test_dipole_potential_and_torque_agree():
 
 def test_trajectory_reports_kinetic_potential_and_total_energy():
     run = compass("split-axes", 0.01, 2.0)
+    # energy is this very sum (the same bits anywhere); V = −(R μ)·B with μ = e_x and B along
+    # y (exact zeros elsewhere) is one product, ≤ 2 roundings a side
     np.testing.assert_allclose(run.energy, run.kinetic_energy + run.potential_energy, rtol=1e-15)
     Rmu = run.R[:, :, 0]  # R μ with μ = e_x
     np.testing.assert_allclose(run.potential_energy, -0.02 * Rmu[:, 1], rtol=1e-14)
