@@ -27,6 +27,9 @@ def _inverted(mesh):
 
 
 def _same(body, expected):
+    # the same mesh integrals over faces taken in another order or orientation: sums of a few
+    # dozen signed tetrahedra of the body's size, without much cancellation (the hollow box:
+    # 8 − 1), so 48 u · 9/7 = 7e-15 relative at most
     assert body.mass == pytest.approx(expected.mass, rel=1e-13)
     assert np.allclose(body.com, expected.com, rtol=0, atol=1e-13)
     assert np.allclose(body.inertia, expected.inertia, rtol=1e-12, atol=1e-13)

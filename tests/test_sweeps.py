@@ -1,7 +1,9 @@
 """tumble.sweep on a real LocalCluster of two worker processes: members, store, resume, refusals.
 
 Every member is compared with the scenario run alone (``rigid_body.run``, which calls
-``simulate``) with np.array_equal: bit for bit, not to a tolerance.
+``simulate``) with np.array_equal: bit for bit, not to a tolerance. That holds on any machine:
+worker and test run the same numba loop (no fastmath: no FMA, no reassociation) on the same
+numbers, and the same NumPy functions on its records.
 """
 
 import json

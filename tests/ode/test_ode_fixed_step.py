@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from roundoff import sum_bound
 
 from tumble import solve
 from tumble.ode.control import fixed_step_count
@@ -33,8 +34,16 @@ def test_nfev_counts_four_per_rk4_step_plus_the_start():
 
 
 def test_hermite_dense_output_interpolates_the_steps_exactly():
-    result = solve(lambda t, y: np.cos(t) * y, (0, 2), [1.0], h=0.25, dense_output=True)
-    np.testing.assert_allclose(result.sol(result.t), result.y, rtol=1e-14)
+    h = 0.25
+    result = solve(lambda t, y: np.cos(t) * y, (0, 2), [1.0], h=h, dense_output=True)
+    # Every node but the last is a step's θ = 0, where y_0 + h Σ_j Q_j 0^j adds an exact zero.
+    np.testing.assert_array_equal(result.sol(result.t[:-1]), result.y[:, :-1])
+    # The last is θ = 1 of the last step: y_0 + h (Q_1 + Q_2 + Q_3), whose terms are
+    # f_0, 3Δ − 2 f_0 − f_1 and f_0 + f_1 − 2Δ (|f| = |cos t y| ≤ |y|, Δ = (y_1 − y_0) / h),
+    # 4|f_0| + 2|f_1| + 5|Δ| in all, rounded in chains of 3 (each Q_j), 3 (their sum) and 3
+    # (h·, y_0 +, and Δ's own).
+    terms = np.abs(result.y).max() * (2 + 11 * h)
+    assert abs(result.sol(result.t[-1])[0] - result.y[0, -1]) <= sum_bound(terms, 9)
 
 
 def test_hermite_dense_output_between_steps_is_fourth_order_accurate():

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from rigid_roundoff import invariant_bound
 
 from tumble import scenarios
 from tumble.scenarios import spinning_top
@@ -19,7 +20,9 @@ def test_every_method_keeps_lz_and_nutates_between_the_classical_bounds(result):
     assert low == pytest.approx(np.degrees(0.3), abs=1e-9) and low < high < 90
     for method, r in summary["results"].items():
         assert r["t_reached"] == summary["t_end"]
-        assert r["L_z_drift"] < 1e-14, method  # the torque of gravity is horizontal
+        # the torque of gravity is horizontal: L_z is kept exactly, only its record rounds
+        # (a few ulps; as in tests/rigid/test_rigid_pivot.py)
+        assert r["L_z_drift"] < 1e-14, method
         theta_min, theta_max = r["theta_range_deg"]
         assert theta_min == pytest.approx(low, abs=1e-6)  # sampled every h: reached to 1e-6
         assert theta_max == pytest.approx(high, abs=1e-4)
@@ -29,7 +32,8 @@ def test_the_splitting_on_the_exact_flow_keeps_energy_and_spin_far_better_than_r
     # Measured: yoshida4 2.1e-11 and 5.5e-15; rkmk4 7.4e-10 and 4.3e-10.
     results = result.summary["results"]
     assert results["yoshida4"]["energy_drift"] < 1e-10
-    assert results["yoshida4"]["L_3_drift"] < 1e-13
+    # on the exact flow L_3 is kept to the walk of the 5000 steps' round-off (1.2e-12)
+    assert results["yoshida4"]["L_3_drift"] < invariant_bound("yoshida4", 5000)
     assert results["rkmk4"]["L_3_drift"] > 1e3 * results["yoshida4"]["L_3_drift"]
 
 

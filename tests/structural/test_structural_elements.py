@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from roundoff import error_bound, sum_bound
 
 from tumble import structural
 from tumble.structural import elements
@@ -32,7 +33,9 @@ def test_stiffness_is_symmetric_positive_semidefinite_with_rank_three(
 ):
     EI = EA * (length / slenderness) ** 2  # radius of gyration h/slenderness: real beams
     K = elements.stiffness_matrices([length], [np.cos(angle)], [np.sin(angle)], [EA], [EI])[0]
-    np.testing.assert_allclose(K, K.T, rtol=0, atol=1e-14 * np.abs(K).max())
+    # K_ij and K_ji are sums of 4 terms T_ai k_ab T_bj (|T| ≤ 1; each ≤ max|k| ≤ 2 max|K|),
+    # rounded in two orders, chains of 6: sum_bound(8 max|K|, 6) = 1.1e-14 max|K|
+    np.testing.assert_allclose(K, K.T, rtol=0, atol=sum_bound(8 * np.abs(K).max(), 6))
     # Jacobi scaling makes the eigenvalues O(1) however far apart EA and EI are
     scaling = 1 / np.sqrt(np.diag(K))
     eigenvalues = np.linalg.eigvalsh(scaling[:, None] * K * scaling[None, :])
@@ -80,6 +83,8 @@ def test_horizontal_stiffness_has_the_textbook_entries():
         )
     )
     transverse = np.ix_([1, 2, 4, 5], [1, 2, 4, 5])
+    # c = 1, s = 0 (exact zeros): EI, h and the integers in another order, ≤ 5 roundings a
+    # side, 1.1e-15 relative
     np.testing.assert_allclose(K[transverse], bending, rtol=1e-14)
     np.testing.assert_allclose(K[np.ix_([0, 3], [0, 3])], EA / h * np.array([[1, -1], [-1, 1]]))
 
@@ -119,14 +124,14 @@ def test_compiled_kernel_matches_the_numpy_reference():
     frame = tilted_frame()
     x = np.random.default_rng(4).standard_normal(frame.n_dofs)
     e = frame.elements
-    reference = np.zeros(frame.n_dofs + 1)  # the last slot collects the fixed DOFs
-    np.add.at(
-        reference,
-        e.dof_map,
-        elements.element_forces(e.gather(x), e.length, e.cos, e.sin, e.EA, e.EI),
-    )
-    # identical operations per element; only the order of the scatter sums may differ
-    np.testing.assert_allclose(frame.internal_forces(x), reference[:-1], rtol=1e-13, atol=1e-9)
+    forces = elements.element_forces(e.gather(x), e.length, e.cos, e.sin, e.EA, e.EI)
+    reference, terms = np.zeros(frame.n_dofs + 1), np.zeros(frame.n_dofs + 1)
+    np.add.at(reference, e.dof_map, forces)  # the last slot collects the fixed DOFs
+    np.add.at(terms, e.dof_map, np.abs(forces))
+    # the same formulas per element, in numba or NumPy (≤ 6 roundings), and the scatter's
+    # sums in another order: on the element forces meeting at each DOF (up to 2e8 N here,
+    # cancelling at the joints; measured 2.3e-10)
+    assert np.all(np.abs(frame.internal_forces(x) - reference[:-1]) <= sum_bound(terms[:-1], 8))
 
 
 def tilted_frame():
@@ -148,4 +153,6 @@ def tilted_frame():
 def test_element_deformations_vanish_for_rigid_rotation(angle):
     x = rigid_motions(1.5, angle)[:, 2][None, :]
     d = elements.natural_deformations(x, [1.5], [np.cos(angle)], [np.sin(angle)])
-    np.testing.assert_allclose(d, 0.0, atol=1e-15)
+    # c Δu + s Δv and (c Δv − s Δu)/h on terms ≤ 2 × 1.5: a difference, products, a sum, and
+    # the rounding of x itself (measured ≤ 2.2e-16)
+    np.testing.assert_allclose(d, 0.0, atol=error_bound(2 * 1.5, 5))
