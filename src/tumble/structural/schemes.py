@@ -67,9 +67,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from tumble import _checks
 from tumble._progress import progress_bar
-from tumble.ode.driver import Status, Stepper, march
+from tumble.ode.driver import Status, march
 from tumble.structural import stepping
 from tumble.structural.alpha import HHT, AlphaScheme, Bathe, GeneralizedAlpha
+from tumble.structural.divergence import likely_cause
 from tumble.structural.factorization import (
     MAX_BANDWIDTH,
     BandedCholesky,
@@ -337,6 +338,7 @@ def integrate(
     if isinstance(scheme, AlphaScheme | Bathe):
         state = scheme.start(system, state, C, dt)
     start = stepper.start(state)
+    stepper.watch.final = n_steps  # checked at the last step too
     with progress_bar(progress, n_steps, scheme.name) as update, _quiet_overflow():
 
         def advance(t: float) -> None:
@@ -358,13 +360,15 @@ def integrate(
             f"record whose energy is finite, t={float(t[first - 1])!r}"
         )
         t, xs, ys, energy = t[:first], xs[:first], ys[:first], energy[:first]
+    if not status.success:
+        message = f"{message}; likely cause: {likely_cause(system, scheme, dt)}"
     return Response(t, xs, ys, energy, scheme.name, dt, system.tip_dof, status, message,
                     solver)  # fmt: skip
 
 
 def _choose_stepper(
     system: LinearSystem, scheme: Scheme, dt: float, C, compiled: bool | None, block: int
-) -> tuple[Stepper, str]:
+) -> tuple[stepping.Watched, str]:
     """The compiled stepper with banded Cholesky factors of the step matrices, or the
     reference stepper with SuperLU; and the solver's name."""
     if isinstance(scheme, AlphaScheme | Bathe):
