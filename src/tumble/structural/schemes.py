@@ -216,10 +216,13 @@ class Response:
         The system's monitored DOF.
     status : Status
         ``Status.SUCCESS``, or ``Status.FAILED`` if the state became non-finite (inf or
-        NaN), or its energy did (a state past 1e150 overflows ``½ xᵀ S x``); the records
-        end with the last one where both are finite.
+        NaN), or its energy did (a state past 1e150 overflows ``½ xᵀ S x``), or its energy
+        grew past a million times what its start and its loads can supply
+        (:mod:`~tumble.structural.divergence`: the run diverged); the records end with the
+        last state before.
     message : str
-        What happened, naming the step's times on failure.
+        What happened, naming the step's times on failure, and then the likely cause
+        (the step against the scheme's critical step, with the numbers).
     solver : str
         How the steps were solved: ``"banded-cholesky"`` (the compiled loop) or
         ``"sparse-lu"`` (the NumPy reference loop); see :func:`integrate`. Empty if
@@ -310,9 +313,11 @@ def integrate(
     Returns
     -------
     Response
-        ``status == Status.FAILED`` if the state became non-finite; the run stops there,
-        with the last finite state as its last record.
-        ``solver`` says which path ran.
+        ``status == Status.FAILED`` if the state became non-finite, or its energy grew past
+        a million times what the initial state and the loads can supply (checked every 64
+        steps and at the last, :mod:`~tumble.structural.divergence`); the run stops there,
+        with the last state before as its last record, and the message names the time, the
+        growth and the likely cause. ``solver`` says which path ran.
 
     Examples
     --------
