@@ -112,7 +112,7 @@ def checked_batch(batch: BatchTrajectory, loaded: bool) -> BatchTrajectory:
     if not may_overflow_batch(batch) and not (loaded and _any_overflow(batch.potential_energy)):
         return batch
     t_last = batch.t_last if batch.t_last is not None else np.full(len(batch), batch.t[-1])
-    for k in np.flatnonzero(batch.status >= 0):
+    for k in np.flatnonzero(batch.status >= 0).tolist():
         run = batch[k]
         index = first_overflow(run)
         if index is None:
