@@ -23,7 +23,10 @@ A stepper is an object with (see :class:`Stepper`, which gives the defaults):
     ``sol(t)`` for ``t`` in ``[t_old, t_new]``: the state between the two (the dense output
     that events are located on). Called only after ``accept``.
 ``finite(state) -> bool``, ``scale(state) -> ndarray``
-    Whether every number of a state is finite; the magnitudes the error is relative to.
+    Whether every number of a state is finite (a stepper may also refuse a finite state it
+    knows to have diverged: the structural steppers' energy check,
+    :mod:`tumble.structural.divergence`; ``failure`` then says so); the magnitudes the
+    error is relative to.
 ``norm(error, old, new, control) -> float``
     The weighted size of a step's error estimate (by default Hairer's RMS norm,
     :func:`~tumble.ode.control.error_norm`, over :meth:`~Stepper.scale`); a step is accepted
@@ -31,12 +34,14 @@ A stepper is an object with (see :class:`Stepper`, which gives the defaults):
     vectors) says here what the tolerances measure.
 ``failure(t_old, t_new) -> str``
     Why the step from ``t_old`` to ``t_new`` gave a state that is not finite (by default
-    :func:`non_finite_message`; an implicit stepper names its unconverged solve).
+    :func:`non_finite_message`; an implicit stepper names its unconverged solve, a structural
+    one the energy that outgrew its bound).
 ``record(state) -> tuple of ndarray``
     One sample: each array with a time axis of length 1 at :attr:`~Stepper.time_axis`.
 ``march_block(state, grid, k0, k1, every, step0) -> Block`` (optional, ``blocks = True``)
     Steps ``k0 + 1 … k1`` of a fixed grid at once, compiled, recording every ``every``-th
-    step: how the kernels keep their speed with no Python per step.
+    step: how the kernels keep their speed with no Python per step. ``Block.failed`` is the
+    step that failed (as ``finite`` would have refused it), the block's state the one before.
 ``march_adaptive(state, t, t1, h, control, every, step0, max_steps) -> AdaptiveBlock``
     (optional, ``adaptive_blocks = True``) Adaptive steps from ``t`` towards ``t1``, compiled,
     with the same controller, norm and minimum step as :func:`march`; it returns at ``t1``,

@@ -26,7 +26,7 @@ from tumble import _checks, so3
 from tumble._progress import announce_compilation
 from tumble.ode.control import fixed_step_count
 from tumble.ode.driver import Block, Grid, Status, Stepper, march, non_finite_message
-from tumble.rigid import geometric, initial
+from tumble.rigid import geometric, initial, overflow
 from tumble.rigid.body import RigidBody
 from tumble.rigid.charts import CHARTS
 from tumble.rigid.forces import (
@@ -460,7 +460,7 @@ def simulate_batch(
     if conservative:  # V for every body and sample at once (mass broadcast over time)
         masses = _per_body(batch.bodies, lambda body: body.mass)[:, None]
         batch.potential_energy = potential_energy(conservative, batch.x, batch.R, masses)
-    return batch
+    return overflow.checked_batch(batch, bool(conservative))
 
 
 class BatchStepper(Stepper):

@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 from tumble import _checks
 from tumble._progress import progress_bar
 from tumble.ode.driver import Control, Jump, march
-from tumble.rigid import geometric, initial
+from tumble.rigid import geometric, initial, overflow
 from tumble.rigid.body import RigidBody
 from tumble.rigid.charts import Dynamics
 from tumble.rigid.forces import (
@@ -42,7 +42,8 @@ log = logging.getLogger(__name__)
 
 
 def _first_step(t_span: float, Y: np.ndarray, body: RigidBody, rtol: float) -> float:
-    omega = np.linalg.norm(body.inertia_inverse @ Y[6:]) + 1e-12
+    with np.errstate(over="ignore"):  # a spin too large for doubles: a status, later
+        omega = np.linalg.norm(body.inertia_inverse @ Y[6:]) + 1e-12
     return min(t_span / 10, 0.1 * rtol ** (1 / 5) / omega)
 
 
@@ -316,7 +317,7 @@ def simulate(
     if out.step_times is not None and out.interpolants is not None:
         sol = Solution(stepper, out.step_times, out.interpolants)
     V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
-    return Trajectory(
+    run = Trajectory(
         t=out.t,
         x=Y_samples[:, :3],
         v=Y_samples[:, 3:6] / body.mass,
@@ -334,6 +335,11 @@ def simulate(
         potential_energy=V,
         sol=sol,
     )
+    attitudes = R_samples if spec.family == "matrix" else None  # the others stay rotations
+    run = overflow.checked(run, Y_samples, attitudes, any(load.conservative for load in loads))
+    if not run.status.success and out.status.success:
+        log.warning("simulate stopped: %s", run.message)
+    return run
 
 
 def _about_pivot(body: RigidBody, t_end: float, pivot: ArrayLike, *, x0, v0, R0, q0, forces,

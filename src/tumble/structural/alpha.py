@@ -91,11 +91,9 @@ from numpy.typing import NDArray
 
 from tumble import _checks
 from tumble._progress import announce_compilation
-from tumble.ode.driver import Stepper
 from tumble.structural.alpha_kernels import run_alpha_steps, run_bathe_steps
 from tumble.structural.factorization import BandedCholesky, factorize
-from tumble.structural.kernels import all_finite
-from tumble.structural.stepping import CompiledStepper, State
+from tumble.structural.stepping import CompiledStepper, Reference, State, Watched
 from tumble.structural.system import LinearSystem
 
 
@@ -164,10 +162,10 @@ class AlphaScheme:
         p = system.internal_forces(k_g * state.y + k_sa * a)
         return AlphaState(state.x, state.y, state.q, p, a, r.copy(), r)
 
-    def reference(self, system, C, dt: float, matrices: list) -> Stepper:
+    def reference(self, system, C, dt: float, matrices: list) -> Watched:
         return AlphaReference(system, C, AlphaCoefficients.of(*self.parameters, dt), matrices[0])
 
-    def compiled(self, system, C, dt: float, factors: list, block: int) -> Stepper:
+    def compiled(self, system, C, dt: float, factors: list, block: int) -> Watched:
         coefficients = AlphaCoefficients.of(*self.parameters, dt)
         return AlphaCompiled(system, C, coefficients, factors, block)
 
@@ -261,27 +259,23 @@ def alpha_step(state: AlphaState, values: tuple, system: LinearSystem, solve, C)
     state.r = r_new
 
 
-class _Reference(Stepper):
-    """A NumPy reference stepper: one ``step_function`` per step on a copy, SuperLU."""
+class AlphaReference(Reference):
+    """:func:`alpha_step` in NumPy with SuperLU, a stepper of the driver."""
 
-    def finite(self, state: State) -> bool:
-        return all_finite(state.x, state.y)
-
-    def record(self, state: State) -> tuple:
-        return state.x[None].copy(), state.y[None].copy()
-
-    def start(self, state: State) -> State:
-        return state
-
-
-class AlphaReference(_Reference):
     def __init__(self, system: LinearSystem, C, coefficients: AlphaCoefficients, A):
         self.system, self.C, self.values, self.solve = system, C, coefficients.values, factorize(A)
+        self.dt = self.values[0]
 
-    def step(self, t: float, state: State, h: float) -> tuple[State, None]:
-        new = state.copy()
-        alpha_step(new, self.values, self.system, self.solve, self.C)  # type: ignore[arg-type]
-        return new, None
+    def advance(self, state: State) -> None:
+        alpha_step(state, self.values, self.system, self.solve, self.C)  # type: ignore[arg-type]
+
+    def acceleration_energy(self, state: State) -> float:
+        return _acceleration_energy(state, self.dt)
+
+
+def _acceleration_energy(state: State, dt: float) -> float:
+    """``½ Δt² a₀ᵀM a₀`` from the carried ``a`` and ``m = M a`` (the watch's start)."""
+    return 0.5 * dt * dt * max(float(state.a @ state.m), 0.0)  # type: ignore[attr-defined]
 
 
 class AlphaCompiled(CompiledStepper):
@@ -292,11 +286,15 @@ class AlphaCompiled(CompiledStepper):
         self.alpha_coefficients = coefficients.values
         self.work = tuple(np.zeros(self.order.size) for _ in range(3))
 
-    def _run(self, state, k0, k1, steps, xs, ys):  # noqa: ANN001, ANN202
+    def acceleration_energy(self, state: State) -> float:
+        return _acceleration_energy(state, self.alpha_coefficients[0])
+
+    def _run(self, state, k0, k1, steps, row, xs, ys):  # noqa: ANN001, ANN202
         announce_compilation(run_alpha_steps, "the generalized-α time loop")
         vectors = state.vectors()
-        return run_alpha_steps(k0, k1, steps, 0, self.alpha_coefficients, vectors, self.frame,
-                               self.factors[0], self.damping, self.work, xs, ys)  # fmt: skip
+        return run_alpha_steps(k0, k1, steps, row, self.alpha_coefficients, vectors, self.frame,
+                               self.factors[0], self.damping, self.work, self.checks, xs,
+                               ys)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -357,10 +355,10 @@ class Bathe:
     def start(self, system: LinearSystem, state: State, C, dt: float) -> State:
         return state
 
-    def reference(self, system, C, dt: float, matrices: list) -> Stepper:
+    def reference(self, system, C, dt: float, matrices: list) -> Watched:
         return BatheReference(system, C, self.coefficients(dt), matrices)
 
-    def compiled(self, system, C, dt: float, factors: list, block: int) -> Stepper:
+    def compiled(self, system, C, dt: float, factors: list, block: int) -> Watched:
         return BatheCompiled(system, C, self.coefficients(dt), factors, block)
 
 
@@ -384,15 +382,16 @@ def bathe_step(state: State, values: tuple, system: LinearSystem, solves, C) -> 
     state.g = system.internal_forces(state.y)
 
 
-class BatheReference(_Reference):
-    def __init__(self, system: LinearSystem, C, values: tuple, matrices: list):
-        self.system, self.C, self.values = system, C, values
-        self.solves = [factorize(A) for A in matrices]
+class BatheReference(Reference):
+    """:func:`bathe_step` in NumPy with SuperLU, a stepper of the driver."""
 
-    def step(self, t: float, state: State, h: float) -> tuple[State, None]:
-        new = state.copy()
-        bathe_step(new, self.values, self.system, self.solves, self.C)
-        return new, None
+    def __init__(self, system: LinearSystem, C, values: tuple, matrices: list):
+        self.system, self.C, self.values, self.dt = system, C, values, values[0]
+        self.solves = [factorize(A) for A in matrices]
+        self.solve = self.solves[0]
+
+    def advance(self, state: State) -> None:
+        bathe_step(state, self.values, self.system, self.solves, self.C)
 
 
 class BatheCompiled(CompiledStepper):
@@ -403,9 +402,9 @@ class BatheCompiled(CompiledStepper):
         self.bathe_coefficients = values
         self.work = tuple(np.zeros(self.order.size) for _ in range(6))
 
-    def _run(self, state, k0, k1, steps, xs, ys):  # noqa: ANN001, ANN202
+    def _run(self, state, k0, k1, steps, row, xs, ys):  # noqa: ANN001, ANN202
         announce_compilation(run_bathe_steps, "the ρ∞-Bathe time loop")
         vectors = state.vectors()
-        return run_bathe_steps(k0, k1, steps, 0, self.bathe_coefficients, vectors, self.frame,
-                               self.factors[0], self.factors[-1], self.damping, self.work, xs,
-                               ys)  # fmt: skip
+        return run_bathe_steps(k0, k1, steps, row, self.bathe_coefficients, vectors, self.frame,
+                               self.factors[0], self.factors[-1], self.damping, self.work,
+                               self.checks, xs, ys)  # fmt: skip

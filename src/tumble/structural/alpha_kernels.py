@@ -15,7 +15,11 @@ import numba
 import numpy as np
 from numpy.typing import NDArray
 
-from tumble.structural.kernels import assemble_internal_forces_pair, banded_solve
+from tumble.structural.kernels import (
+    assemble_internal_forces_pair,
+    banded_solve,
+    energy_exceeds,
+)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -30,23 +34,27 @@ def run_alpha_steps(
     factor: tuple,
     damping: tuple,
     work: tuple,
+    watch: tuple,
     xs: NDArray[np.float64],
     ys: NDArray[np.float64],
-) -> tuple[int, int]:
+) -> tuple[int, int, float]:
     """Steps ``first + 1 … last`` of :func:`tumble.structural.alpha.alpha_step`.
 
     ``coefficients`` are :attr:`tumble.structural.alpha.AlphaCoefficients.values`;
     ``state`` is ``(x, y, q, p, a, m, r)`` (:class:`~tumble.structural.alpha.AlphaState`),
     ``work`` two scratch vectors (``Δx``, then ``k_g y + k_sa a``) and ``S Δx``. Returns the
-    next record row and the step that became non-finite (or -1), as ``run_steps``.
+    next record row, the step that became non-finite or failed the energy check ``watch``
+    (or -1) and the energy at that check (or -1.0), as ``run_steps``.
     """
     dt, c_r, k_g, k_sa, k_dy, k_a, a_keep, a_gain, m_new, m_old, m_prev = coefficients
     x, y, q, p, a, m, r = state
     rhs, combined, sdx = work
     indptr, indices, data = damping
     n = x.size
-    diverged = -1
+    diverged, energy = -1, -1.0
     damped = indptr.size > 0
+    every, final, no_lag = watch[0], watch[1], x[:0]
+    until_check = every - first % every
     for k in range(first + 1, last + 1):
         for i in range(n):
             rhs[i] = dt * (c_r * r[i] + (1.0 - c_r) * m[i] - p[i])
@@ -71,14 +79,22 @@ def run_alpha_steps(
                     r_new -= data[j] * y[indices[j]]
             m[i] = m_new * r_new + m_old * r[i] - m_prev * m[i]
             r[i] = r_new
+        until_check -= 1
+        grown = False
+        if (until_check == 0 or k == final) and not non_finite:
+            grown, value = energy_exceeds(k * dt, x, y, q, no_lag, watch)
+            if grown:
+                energy = value
+        if until_check == 0:
+            until_check = every
         if non_finite or k == record_steps[row]:
             xs[row] = x
             ys[row] = y
             row += 1
-        if non_finite:
+        if non_finite or grown:
             diverged = k
             break
-    return row, diverged
+    return row, diverged, energy
 
 
 @numba.njit(cache=True, nogil=True)
@@ -94,23 +110,27 @@ def run_bathe_steps(
     second_factor: tuple,
     damping: tuple,
     work: tuple,
+    watch: tuple,
     xs: NDArray[np.float64],
     ys: NDArray[np.float64],
-) -> tuple[int, int]:
+) -> tuple[int, int, float]:
     """Steps ``first + 1 … last`` of :func:`tumble.structural.alpha.bathe_step`.
 
     ``coefficients`` are ``(Δt, τ = γΔt, d₀, d₁, q₂)``; ``state`` is ``(x, y, q, g = S y)``;
     ``factor`` and ``second_factor`` those of the two sub-steps' matrices (the same one at
     the optimal splitting ratio); ``work`` holds the right-hand side, ``Δx``, ``S Δx``,
-    ``rⁿ``, ``yⁿ`` (then ``w = d₀yⁿ + d₁y^m``) and ``S yⁿ``.
+    ``rⁿ``, ``yⁿ`` (then ``w = d₀yⁿ + d₁y^m``) and ``S yⁿ``; ``watch`` and the returns as
+    :func:`run_alpha_steps`.
     """
     dt, tau, d0, d1, q2 = coefficients
     x, y, q, g = state
     rhs, dxs, sdx, r_old, y_old, g_old = work
     indptr, indices, data = damping
     n = x.size
-    diverged = -1
+    diverged, energy = -1, -1.0
     damped = indptr.size > 0
+    every, final, no_lag = watch[0], watch[1], x[:0]
+    until_check = every - first % every
     for k in range(first + 1, last + 1):
         for i in range(n):  # trapezoidal sub-step over τ; r = q − C y
             r_old[i] = q[i]
@@ -147,11 +167,19 @@ def run_bathe_steps(
         assemble_internal_forces_pair(dxs, y, *frame, sdx, g)  # type: ignore[call-arg]
         for i in range(n):
             q[i] -= sdx[i]
+        until_check -= 1
+        grown = False
+        if (until_check == 0 or k == final) and not non_finite:
+            grown, value = energy_exceeds(k * dt, x, y, q, no_lag, watch)
+            if grown:
+                energy = value
+        if until_check == 0:
+            until_check = every
         if non_finite or k == record_steps[row]:
             xs[row] = x
             ys[row] = y
             row += 1
-        if non_finite:
+        if non_finite or grown:
             diverged = k
             break
-    return row, diverged
+    return row, diverged, energy

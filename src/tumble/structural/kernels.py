@@ -122,6 +122,50 @@ def all_finite(x: NDArray[np.float64], y: NDArray[np.float64]) -> bool:
     return True
 
 
+@numba.njit(cache=True, nogil=True)
+def energy_exceeds(
+    t: float, x: NDArray[np.float64], y: NDArray[np.float64], q: NDArray[np.float64],
+    lag: NDArray[np.float64], watch: tuple,
+) -> tuple[bool, float]:  # fmt: skip
+    """Whether ``V = ½ yᵀM y + ½ xᵀ(f − q + lag)`` passes ``growth (√V₀ + P t)²``; and ``V``
+    when it does.
+
+    The check of :mod:`tumble.structural.divergence`; ``watch`` is
+    :meth:`~tumble.structural.divergence.EnergyWatch.kernel`'s ``(every, final, √V₀, P,
+    growth, mass, f, c)``: ``mass[p, j] = M[p, p − j]``, the lower band of ``M`` row by row
+    (0 where ``p < j``), and ``c ≥ λ_max(D^{-½} M D^{-½})`` with ``D = diag M``. ``lag`` is
+    the ``S Δx`` not yet taken from ``q`` (empty: none). First the bound
+    ``V ≤ ½ c yᵀD y + ½ xᵀS x`` (a pass as cheap as two dot products); only when that
+    passes the limit, ``yᵀM y`` itself from the band (the check then costs about a step).
+    A NaN ``V`` passes.
+    """
+    root, power, growth, mass, f, c = watch[2], watch[3], watch[4], watch[5], watch[6], watch[7]
+    n = x.size
+    strain = 0.0
+    diagonal = 0.0
+    if lag.size:
+        for p in range(n):
+            strain += x[p] * (f[p] - q[p] + lag[p])
+            diagonal += mass[p, 0] * y[p] * y[p]
+    else:
+        for p in range(n):
+            strain += x[p] * (f[p] - q[p])
+            diagonal += mass[p, 0] * y[p] * y[p]
+    bound = root + power * t
+    limit = growth * bound * bound
+    if 0.5 * (c * diagonal + strain) <= limit:
+        return False, -1.0
+    b = mass.shape[1] - 1
+    kinetic = 0.0
+    for p in range(n):
+        acc = 0.0
+        for j in range(1, min(p, b) + 1):
+            acc += mass[p, j] * y[p - j]
+        kinetic += y[p] * (mass[p, 0] * y[p] + 2.0 * acc)
+    energy = 0.5 * (kinetic + strain)
+    return not energy <= limit, energy
+
+
 @numba.njit(cache=True, nogil=True, fastmath={"contract"})
 def banded_solve(
     forward: NDArray[np.float64],
@@ -172,9 +216,10 @@ def run_steps(
     mass_factor: tuple,
     damping: tuple,
     work: tuple,
+    watch: tuple,
     xs: NDArray[np.float64],
     ys: NDArray[np.float64],
-) -> tuple[int, int]:
+) -> tuple[int, int, float]:
     """Steps ``first + 1 … last`` of :func:`tumble.structural.stepping.reference_step`.
 
     The same operations in the same order, with the NumPy reference's sparse LU solve
@@ -205,6 +250,9 @@ def run_steps(
         ``C`` as CSR ``(indptr, indices, data)``; ``indptr`` empty when undamped.
     work : tuple of 4 ndarrays, shape (n,)
         Scratch: right-hand side, then ``Δy``, then ``Δx``; ``S Δx``; ``a``; ``S a``.
+    watch : tuple
+        The energy check (:func:`energy_exceeds`), made after every step that is a multiple
+        of ``watch[0]`` and after step ``watch[1]`` (the run's last).
     xs, ys : ndarray, shape (n_records, n)
         Records, filled from ``row``.
 
@@ -213,7 +261,10 @@ def run_steps(
     row : int
         The next row to fill.
     diverged : int
-        The step at which the state became non-finite (recorded, and the run stops), or -1.
+        The step at which the state became non-finite (recorded) or failed the energy check,
+        where the loop stopped; or -1.
+    energy : float
+        ``V`` at the failed check, or -1.0 (none failed: a non-finite state, or no stop).
     """
     # The type: ignore[call-arg] below: numba's stubs count a *tuple into a Dispatcher wrongly.
     dt, k_g, k_dy, k_sa, k_a = coefficients
@@ -223,7 +274,9 @@ def run_steps(
     indptr, indices, data = damping
     n = x.size
     h[:] = 0.0
-    diverged = -1
+    diverged, energy = -1, -1.0
+    every, final = watch[0], watch[1]
+    until_check = every - first % every
     for k in range(first + 1, last + 1):
         for i in range(n):  # r = q − C y, q = f − S x first taking the last step's S Δx
             q[i] -= h[i]
@@ -257,13 +310,21 @@ def run_steps(
             assemble_internal_forces_pair(rhs, y, *frame, h, g)  # type: ignore[call-arg]
         else:
             assemble_internal_forces(rhs, *frame, h)  # type: ignore[call-arg]
+        until_check -= 1
+        grown = False
+        if (until_check == 0 or k == final) and not non_finite:
+            grown, value = energy_exceeds(k * dt, x, y, q, h, watch)
+            if grown:
+                energy = value
+        if until_check == 0:
+            until_check = every
         if non_finite or k == record_steps[row]:
             xs[row] = x
             ys[row] = y
             row += 1
-        if non_finite:
+        if non_finite or grown:
             diverged = k
             break
     for i in range(n):
         q[i] -= h[i]
-    return row, diverged
+    return row, diverged, energy

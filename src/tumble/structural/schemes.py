@@ -67,9 +67,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from tumble import _checks
 from tumble._progress import progress_bar
-from tumble.ode.driver import Status, Stepper, march
+from tumble.ode.driver import Status, march
 from tumble.structural import stepping
 from tumble.structural.alpha import HHT, AlphaScheme, Bathe, GeneralizedAlpha
+from tumble.structural.divergence import likely_cause
 from tumble.structural.factorization import (
     MAX_BANDWIDTH,
     BandedCholesky,
@@ -215,10 +216,13 @@ class Response:
         The system's monitored DOF.
     status : Status
         ``Status.SUCCESS``, or ``Status.FAILED`` if the state became non-finite (inf or
-        NaN), or its energy did (a state past 1e150 overflows ``½ xᵀ S x``); the records
-        end with the last one where both are finite.
+        NaN), or its energy did (a state past 1e150 overflows ``½ xᵀ S x``), or its energy
+        grew past a million times what its start and its loads can supply
+        (:mod:`~tumble.structural.divergence`: the run diverged); the records end with the
+        last state before.
     message : str
-        What happened, naming the step's times on failure.
+        What happened, naming the step's times on failure, and then the likely cause
+        (the step against the scheme's critical step, with the numbers).
     solver : str
         How the steps were solved: ``"banded-cholesky"`` (the compiled loop) or
         ``"sparse-lu"`` (the NumPy reference loop); see :func:`integrate`. Empty if
@@ -309,9 +313,11 @@ def integrate(
     Returns
     -------
     Response
-        ``status == Status.FAILED`` if the state became non-finite; the run stops there,
-        with the last finite state as its last record.
-        ``solver`` says which path ran.
+        ``status == Status.FAILED`` if the state became non-finite, or its energy grew past
+        a million times what the initial state and the loads can supply (checked every 64
+        steps and at the last, :mod:`~tumble.structural.divergence`); the run stops there,
+        with the last state before as its last record, and the message names the time, the
+        growth and the likely cause. ``solver`` says which path ran.
 
     Examples
     --------
@@ -337,6 +343,7 @@ def integrate(
     if isinstance(scheme, AlphaScheme | Bathe):
         state = scheme.start(system, state, C, dt)
     start = stepper.start(state)
+    stepper.watch.final = n_steps  # checked at the last step too
     with progress_bar(progress, n_steps, scheme.name) as update, _quiet_overflow():
 
         def advance(t: float) -> None:
@@ -358,13 +365,15 @@ def integrate(
             f"record whose energy is finite, t={float(t[first - 1])!r}"
         )
         t, xs, ys, energy = t[:first], xs[:first], ys[:first], energy[:first]
+    if not status.success:
+        message = f"{message}; likely cause: {likely_cause(system, scheme, dt)}"
     return Response(t, xs, ys, energy, scheme.name, dt, system.tip_dof, status, message,
                     solver)  # fmt: skip
 
 
 def _choose_stepper(
     system: LinearSystem, scheme: Scheme, dt: float, C, compiled: bool | None, block: int
-) -> tuple[Stepper, str]:
+) -> tuple[stepping.Watched, str]:
     """The compiled stepper with banded Cholesky factors of the step matrices, or the
     reference stepper with SuperLU; and the solver's name."""
     if isinstance(scheme, AlphaScheme | Bathe):

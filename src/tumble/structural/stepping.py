@@ -36,7 +36,8 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from tumble._progress import announce_compilation
-from tumble.ode.driver import Block, Grid, Stepper
+from tumble.ode.driver import Block, Grid, Stepper, non_finite_message
+from tumble.structural.divergence import EnergyWatch, mechanical_energy
 from tumble.structural.factorization import BandedCholesky, factorize
 from tumble.structural.kernels import all_finite, run_steps
 from tumble.structural.system import LinearSystem
@@ -130,48 +131,101 @@ def reference_step(
         state.g = forces(state.y)
 
 
-class ReferenceStepper(Stepper):
-    """The NumPy reference as a stepper of :func:`tumble.ode.driver.march`: SuperLU, one
-    :func:`reference_step` a step (on a copy, so that a non-finite step leaves the last
-    finite state)."""
+class Watched(Stepper):
+    """What every structural stepper shares: the energy check of
+    :mod:`tumble.structural.divergence` (:attr:`watch`, made from the initial state by
+    :meth:`start`) and the message of a run that failed it."""
 
-    def __init__(self, system: LinearSystem, k: Increments, A: sp.spmatrix, C):
-        self.system, self.k, self.C = system, k, C
-        self.solve = factorize(A)
-        self.solve_mass = factorize(system.M) if k.mass_solve else None
+    system: LinearSystem
+    watch: EnergyWatch
+    solve: Solve
+    """``A⁻¹`` of the step matrix (``A ≥ M``), for the watch's first bound."""
+    failed_check = False
 
     def start(self, state: State) -> State:
-        """The stepped state: ``state`` itself."""
+        """The stepped state: ``state`` itself, and the watch from it."""
+        self.watch = EnergyWatch.start(
+            self.system, state.x, state.y, state.q, self.solve, self.acceleration_energy(state)
+        )
         return state
+
+    def acceleration_energy(self, state: State) -> float:
+        """``½ Δt² a₀ᵀM a₀`` [J] of a scheme that carries the acceleration, else 0
+        (:mod:`~tumble.structural.divergence`: part of what its start supplies)."""
+        return 0.0
+
+    def failure(self, t_old: float, t_new: float) -> str:
+        if self.failed_check:
+            return self.watch.message(t_old, t_new)
+        return non_finite_message(t_old, t_new)
+
+
+class Reference(Watched):
+    """A NumPy reference stepper: ``advance(state)`` in place, on a copy of each state, so
+    that a failed step leaves the last good one; the energy checked as in the compiled
+    loops, every :data:`~tumble.structural.divergence.CHECK_EVERY` steps of ``dt``."""
+
+    dt: float
+
+    def advance(self, state: State) -> None:
+        raise NotImplementedError
 
     def step(self, t: float, state: State, h: float) -> tuple[State, None]:
         new = state.copy()
-        reference_step(new, self.k, self.system, self.solve, self.solve_mass, self.C)
+        self.advance(new)
+        self.step_index = round((t + h) / self.dt)
         return new, None
 
     def finite(self, state: State) -> bool:
-        return all_finite(state.x, state.y)
+        if not all_finite(state.x, state.y):
+            return False
+        if not self.watch.checks(self.step_index):
+            return True
+        t = self.step_index * self.dt
+        energy = mechanical_energy(self.system, state.x, state.y, state.q)
+        self.failed_check = self.watch.exceeds(t, energy) and self.watch.confirms(t, energy)
+        return not self.failed_check
 
     def record(self, state: State) -> tuple:
         return state.x[None].copy(), state.y[None].copy()
 
 
-class CompiledStepper(Stepper):
+class ReferenceStepper(Reference):
+    """The NumPy reference as a stepper of :func:`tumble.ode.driver.march`: SuperLU, one
+    :func:`reference_step` a step."""
+
+    def __init__(self, system: LinearSystem, k: Increments, A: sp.spmatrix, C):
+        self.system, self.k, self.C, self.dt = system, k, C, k.dt
+        self.solve = factorize(A)
+        self.solve_mass = factorize(system.M) if k.mass_solve else None
+
+    def advance(self, state: State) -> None:
+        reference_step(state, self.k, self.system, self.solve, self.solve_mass, self.C)
+
+    def acceleration_energy(self, state: State) -> float:
+        return _acceleration_energy(self.system, state, self.C, self.solve_mass, self.dt)
+
+
+class CompiledStepper(Watched):
     """:func:`~tumble.structural.kernels.run_steps` as a stepper of the driver: blocks of
     steps compiled, with the banded Cholesky of :class:`~tumble.structural.factorization.
     BandedCholesky`.
 
     Everything is put in the factor's DOF order (``factor.order``) once, so the loop never
     permutes; :meth:`record` and the blocks' records put it back. A block that meets a
-    non-finite state is replayed from its start to the step before (the same operations,
-    so the same numbers): the run keeps its last finite state at no cost per step.
+    non-finite state, or fails the energy check, is replayed from its start to the step
+    before (the same operations, so the same numbers): the run keeps its last good state at
+    no cost per step. A check that fails only the first bound (``P_A``, module
+    :mod:`~tumble.structural.divergence`) goes on from where it stopped with the true one.
     """
 
     blocks = True
+    solve_mass: Solve | None = None
 
     def __init__(self, system: LinearSystem, k: Increments, factor: BandedCholesky, C, block):
         mass = BandedCholesky.from_matrix(system.M, factor.order) if k.mass_solve else factor
         self.prepare(system, (factor, mass), C, block)
+        self.C, self.solve_mass = C, mass.solve if k.mass_solve else None
         self.coefficients = (k.dt, k.k_g, k.k_dy, k.k_sa, k.k_a)
         self.work = tuple(np.zeros(self.order.size) for _ in range(4))
 
@@ -189,20 +243,28 @@ class CompiledStepper(Stepper):
         self.frame = (permuted_map.astype(np.int32), *element_arrays)
         self.damping = _csr_arrays(None if C is None else sp.csr_matrix(C)[order][:, order])
         self.block_steps = block
+        self.system, self.solve = system, factors[0].solve
 
     def start(self, state: State) -> State:
-        """``state`` in the factor's DOF order."""
+        """``state`` in the factor's DOF order, and the watch from it."""
+        super().start(state)
         return state.permuted(self.order)
 
     def record(self, state: State) -> tuple:
         return state.x[self.inverse][None], state.y[self.inverse][None]
 
-    def _run(self, state: State, k0: int, k1: int, steps: NDArray[np.int64], xs, ys):
+    def acceleration_energy(self, state: State) -> float:
+        if self.solve_mass is None:
+            return 0.0
+        dt = self.coefficients[0]
+        return _acceleration_energy(self.system, state, self.C, self.solve_mass, dt)
+
+    def _run(self, state: State, k0: int, k1: int, steps: NDArray[np.int64], row: int, xs, ys):
         vectors = (state.x, state.y, state.q, state.g)
         announce_compilation(run_steps, "the structural time loop")
         factor, mass = self.factors
-        return run_steps(k0, k1, steps, 0, self.coefficients, vectors, self.frame, factor, mass,
-                         self.damping, self.work, xs, ys)  # fmt: skip
+        return run_steps(k0, k1, steps, row, self.coefficients, vectors, self.frame, factor,
+                         mass, self.damping, self.work, self.checks, xs, ys)  # fmt: skip
 
     def march_block(
         self, state: State, grid: Grid, k0: int, k1: int, every: int, step0: int
@@ -213,14 +275,30 @@ class CompiledStepper(Stepper):
         xs, ys = np.empty((steps.size + 1, n)), np.empty((steps.size + 1, n))
         start = state.copy()
         steps_padded = np.append(steps, -1)  # the kernel reads one entry past its last record
-        rows, failed = self._run(state, k0, k1, steps_padded, xs, ys)
+        self.checks = self.watch.kernel(self.order)
+        rows, failed, energy = self._run(state, k0, k1, steps_padded, 0, xs, ys)
+        while failed >= 0 and not energy < 0:  # a failed energy check (-1.0: non-finite)
+            self.failed_check = self.watch.confirms(grid.time(failed), energy)
+            if self.failed_check:
+                break
+            self.checks = self.watch.kernel(self.order)  # the true bound holds: go on
+            rows, failed, energy = self._run(state, failed, k1, steps_padded, rows, xs, ys)
         if failed >= 0:  # replay to the step before, from the block's start
             state, rows = start, int(np.searchsorted(steps, failed))
-            self._run(state, k0, failed - 1, steps_padded, xs, ys)
+            self._run(state, k0, failed - 1, steps_padded, 0, xs, ys)
         times = np.array([grid.time(int(step)) for step in steps[:rows]])
         return Block(
             times, (xs[:rows][:, self.inverse], ys[:rows][:, self.inverse]), state, failed
         )
+
+
+def _acceleration_energy(system: LinearSystem, state: State, C, solve_mass, dt: float) -> float:
+    """``½ Δt² a₀ᵀM a₀`` with ``M a₀ = q − C y`` for Newmark with ``2β ≠ γ`` (which carries
+    ``a``); 0 without a mass solve."""
+    if solve_mass is None:
+        return 0.0
+    r = state.q - (0.0 if C is None else C @ state.y)
+    return 0.5 * dt * dt * max(float(solve_mass(r) @ r), 0.0)
 
 
 def _kernel_factor(factor: BandedCholesky) -> tuple:
