@@ -218,10 +218,10 @@ def run_row(row: Row, problem: Problem, setting: float, *, t_end: float | None =
 def fixed_step_end(row: Row, problem: Problem, h: float) -> np.ndarray:
     """R(T) of an adaptive row's formula stepped at a fixed ``h``, without its controller.
 
-    A tumble method: its own stepper (:func:`tumble.rigid.simulation.stepper_for`, what
-    ``simulate`` builds) handed to :func:`tumble.ode.driver.march` with no
-    :class:`~tumble.ode.driver.Control`, so every step is taken at ``h``; scipy: ``solve_ivp``
-    with ``first_step = max_step = h`` and tolerances too loose to reject a step.
+    A tumble method: its own stepper (what ``simulate`` builds, :func:`_fixed_step_stepper`)
+    handed to :func:`tumble.ode.march` with no :class:`~tumble.ode.driver.Control`, so every
+    step is taken at ``h``; scipy: ``solve_ivp`` with ``first_step = max_step = h`` and
+    tolerances too loose to reject a step.
     """
     if row.source == "scipy":
         from scipy.integrate import solve_ivp
@@ -231,16 +231,27 @@ def fixed_step_end(row: Row, problem: Problem, h: float) -> np.ndarray:
                                  method=row.name.split()[-1], first_step=h, max_step=h,
                                  rtol=1e10, atol=1e10)  # fmt: skip
         return so3.matrix_from_quat(solution.y[3:, -1])
-    from tumble.ode.driver import march
+    from tumble.ode import march
+
+    stepper, state = _fixed_step_stepper(row, problem)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = march(stepper, (0.0, problem.t_end), state, h=h, record_every=2**62)
+    return out.records[0][-1]
+
+
+def _fixed_step_stepper(row: Row, problem: Problem):
+    """The stepper ``simulate`` builds for ``row`` on ``problem`` (compiled where the loads
+    allow), and its start.
+
+    The one place the report card reaches into :mod:`tumble.rigid`'s internals:
+    ``simulate`` has no public way to step an adaptive method's formula at a fixed ``h``.
+    """
     from tumble.rigid import initial
     from tumble.rigid.forces import compiled_loads
     from tumble.rigid.simulation import stepper_for
 
     R, Y = initial.initial_state(problem.body, None, None, None, None, problem.omega0, None)
-    loads = problem.forces()  # the compiled stepper where the loads allow, as simulate does
+    loads = problem.forces()
     kernel_loads = compiled_loads(loads, problem.body.mass)
     stepper = stepper_for(METHODS[row.name], problem.body, loads, kernel_loads)
-    with np.errstate(over="ignore", invalid="ignore"):
-        out = march(stepper, (0.0, problem.t_end), stepper.start((R, Y)), h=h,
-                    record_every=2**62)  # fmt: skip
-    return out.records[0][-1]
+    return stepper, stepper.start((R, Y))
