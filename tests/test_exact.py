@@ -15,6 +15,7 @@ from scipy.integrate import solve_ivp
 from scipy.special import ellipj, ellipk
 
 from tumble.exact import (
+    fit_order,
     free_body,
     free_body_period,
     free_body_rotation,
@@ -22,6 +23,7 @@ from tumble.exact import (
     observed_order,
     projectile,
     sphere,
+    study,
 )
 
 T_HANDLE = np.array([9.82271303e-05, 7.22671030e-05, 1.57865031e-04])  # SPEC §4, kg m^2
@@ -397,3 +399,65 @@ def test_measure_order_finds_the_order_of_simple_methods(order, stages):
 def test_observed_order_rejects_bad_input_naming_the_argument(step_sizes, errors, name):
     with pytest.raises(ValueError, match=f"^{name}"):
         observed_order(step_sizes, errors)
+
+
+# --- the one study harness and the one fit policy -------------------------------------------
+
+
+def test_study_warms_up_once_and_keeps_the_fastest_of_repeat_runs():
+    calls, warm = [], []
+    times = iter([3.0, 1.0, 2.0, 5.0, 4.0, 6.0])  # each run's own time, in call order
+
+    def run(h):
+        calls.append(h)
+        return {"error": h**2, "seconds": next(times)}
+
+    trials = study(run, [0.2, 0.1], lambda r: r["error"], repeat=3,
+                   warm_up=lambda: warm.append(True), seconds=lambda r: r["seconds"])  # fmt: skip
+    assert warm == [True] and calls == [0.2] * 3 + [0.1] * 3
+    assert [trial.seconds for trial in trials] == [1.0, 4.0]
+    assert [trial.result["seconds"] for trial in trials] == [1.0, 4.0]
+    assert trials[1].error == pytest.approx(0.01) and trials[1].setting == 0.1
+
+
+def test_study_makes_a_failed_runs_error_infinite():
+    trials = study(lambda h: h, [1.0, 2.0], lambda h: math.nan if h > 1 else h)
+    assert [trial.error for trial in trials] == [1.0, math.inf]
+
+
+def test_study_without_an_error_only_times():
+    (trial,) = study(lambda h: h, [1.0])
+    assert math.isnan(trial.error) and trial.seconds >= 0.0
+
+
+def test_study_stops_when_until_says_finer_settings_add_nothing():
+    trials = study(lambda h: h, [1e-1, 1e-2, 1e-3, 1e-4], lambda h: h,
+                   until=lambda done: done[-1].error < 5e-2)  # fmt: skip
+    assert [trial.setting for trial in trials] == [1e-1, 1e-2]
+
+
+def test_fit_order_fits_the_finest_errors_inside_the_window():
+    h = np.array([0.8, 0.4, 0.2, 0.1, 0.05, 0.025])
+    e = 3.0 * h**4
+    e[0], e[-1] = 10.0, 1e-16  # out of the asymptotic range; at round-off
+    fit = fit_order(h, e, window=(1e-13, 1.0), finest=3)
+    assert fit is not None and fit.order == pytest.approx(4.0, abs=1e-12)
+    assert fit.step_sizes.tolist() == [0.2, 0.1, 0.05]  # the three finest inside
+    assert (fit.h_min, fit.h_max, fit.points) == (0.05, 0.2, 3)
+    assert fit.used.tolist() == [False, False, True, True, True, False]
+
+
+def test_fit_order_leaves_out_failed_runs():
+    fit = fit_order([0.4, 0.2, 0.1], [math.inf, 4e-2, 1e-2])
+    assert fit is not None and fit.points == 2 and fit.order == pytest.approx(2.0)
+
+
+def test_fit_order_is_none_with_fewer_distinct_steps_than_asked():
+    assert fit_order([0.2, 0.1, 0.05], [1e-2, 1e-3, 1e-20], window=(1e-13, 1.0),
+                     minimum=3) is None  # fmt: skip
+    assert fit_order([0.2, 0.1, 0.05], [1e-2, 1e-3, 1e-20], window=(1e-13, 1.0)) is not None
+
+
+def test_fit_order_refuses_mismatched_errors_by_name():
+    with pytest.raises(ValueError, match="^errors"):
+        fit_order([0.2, 0.1], [1e-2])

@@ -1,5 +1,10 @@
 """Exact reference solutions: projectile, isotropic sphere, torque-free body; order measurement.
 
+Every order and work–precision study in tumble (the convergence scenario, ``work_precision``,
+the report card and its structural rows) runs through one harness, :func:`study` (warm up,
+best of N, error against the reference), and fits through one policy, :func:`fit_order`
+(which errors enter the fit), which calls :func:`observed_order`.
+
 Conventions (SPEC §2): SI units; R maps body to world; ω_body = Rᵀ ω_world; inertia about the
 centre of mass in body axes; Euler's equations I ω̇ = (I ω) × ω; L = R I ω_body is constant.
 
@@ -12,8 +17,11 @@ References
 
 from __future__ import annotations
 
+import math
+import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Generic, SupportsFloat, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -29,7 +37,10 @@ from tumble._elliptic import (
 )
 
 __all__ = [
+    "OrderFit",
     "Projectile",
+    "Trial",
+    "fit_order",
     "free_body",
     "free_body_period",
     "free_body_rotation",
@@ -37,6 +48,7 @@ __all__ = [
     "observed_order",
     "projectile",
     "sphere",
+    "study",
 ]
 
 
@@ -364,8 +376,202 @@ def measure_order(
     2.0
     """
     h = _checks.values("step_sizes", step_sizes, minimum=2, unit="s", positive=True)
-    errors = np.array([float(run(float(step))) for step in h])
+    errors = np.array([trial.error for trial in study(run, h, error=float)])
     return observed_order(h, errors), errors
+
+
+R = TypeVar("R")
+
+
+@dataclass(frozen=True)
+class Trial(Generic[R]):
+    """One setting of a :func:`study`: its error, its time and the run itself.
+
+    Attributes
+    ----------
+    setting : float
+        The step h (s) or the tolerance the run was given.
+    error : float
+        The run's error against the reference; ``inf`` when it is not finite (a failed run),
+        NaN when the study measured none.
+    seconds : float
+        The best time of the study's ``repeat`` runs (s).
+    result : object
+        What the fastest run returned.
+    """
+
+    setting: float
+    error: float
+    seconds: float
+    result: R
+
+
+def study(
+    run: Callable[[float], R],
+    settings: ArrayLike,
+    error: Callable[[R], SupportsFloat] | None = None,
+    *,
+    repeat: int = 1,
+    warm_up: Callable[[], object] | None = None,
+    seconds: Callable[[R], float] | None = None,
+    until: Callable[[list[Trial[R]]], bool] | None = None,
+) -> list[Trial[R]]:
+    """Run a method at each setting, timed, and measure each run's error: the one harness.
+
+    The work–precision diagrams, the order studies and the report card all measure this way:
+    ``warm_up()`` once (numba's compilation and the first call's imports are not timed), then
+    for each setting the best time of ``repeat`` calls ``run(setting)`` (the least disturbed
+    by other work) and ``error`` of the fastest; a non-finite error (a run that blew up or
+    stopped) is ``inf``.
+
+    Parameters
+    ----------
+    run : callable
+        ``run(setting) -> result``: one integration with that step (s) or tolerance.
+    settings : sequence of float, shape (k,)
+        The settings, in the order they are run.
+    error : callable, optional
+        ``error(result) -> float``: the run's distance to the reference; None only times the
+        runs (each error NaN).
+    repeat : int
+        Timed calls per setting, >= 1.
+    warm_up : callable, optional
+        Called once before the first timed call.
+    seconds : callable, optional
+        ``seconds(result)``: the run's own time, when it times only the integration; default
+        the wall time of the call (``time.perf_counter``).
+    until : callable, optional
+        ``until(trials) -> bool``, asked after each setting: True stops the study (finer
+        settings would add nothing, e.g. once two errors are at round-off).
+
+    Returns
+    -------
+    list of Trial
+        One per setting run, in order.
+
+    Examples
+    --------
+    >>> trials = study(lambda h: 3.0 * h**2, [0.1, 0.05], error=lambda e: e)
+    >>> [round(trial.error, 6) for trial in trials]
+    [0.03, 0.0075]
+    """
+    repeat = _checks.count("repeat", repeat)
+    if warm_up is not None:
+        warm_up()
+    trials: list[Trial[R]] = []
+    for setting in np.asarray(settings, dtype=float).tolist():
+        best, fastest = math.inf, None
+        for _ in range(repeat):
+            start = time.perf_counter()
+            result = run(setting)
+            took = time.perf_counter() - start if seconds is None else seconds(result)
+            if fastest is None or took < best:
+                best, fastest = took, result
+        assert fastest is not None
+        value = math.nan if error is None else float(error(fastest))
+        if error is not None and not math.isfinite(value):
+            value = math.inf
+        trials.append(Trial(setting, value, best, fastest))
+        if until is not None and until(trials):
+            break
+    return trials
+
+
+@dataclass(frozen=True)
+class OrderFit:
+    """An observed order and the runs it was fitted through (:func:`fit_order`).
+
+    Attributes
+    ----------
+    order : float
+        The least-squares slope of log e against log h.
+    step_sizes : ndarray, shape (m,)
+        The fitted step sizes (s).
+    errors : ndarray, shape (m,)
+        Their errors.
+    used : ndarray of bool, shape (k,)
+        Which of the given runs were fitted.
+    """
+
+    order: float
+    step_sizes: np.ndarray
+    errors: np.ndarray
+    used: np.ndarray
+
+    @property
+    def points(self) -> int:
+        """How many runs were fitted."""
+        return int(self.step_sizes.size)
+
+    @property
+    def h_min(self) -> float:
+        """The finest fitted step (s)."""
+        return float(self.step_sizes.min())
+
+    @property
+    def h_max(self) -> float:
+        """The coarsest fitted step (s)."""
+        return float(self.step_sizes.max())
+
+
+def fit_order(
+    step_sizes: ArrayLike,
+    errors: ArrayLike,
+    *,
+    window: tuple[float, float] = (0.0, math.inf),
+    finest: int | None = None,
+    minimum: int = 2,
+) -> OrderFit | None:
+    """The observed order through the errors that measure truncation: the one fit policy.
+
+    An error enters the fit when it is finite and inside the open ``window`` = (floor,
+    ceiling): above the floor it is truncation, not round-off or the reference's own error;
+    below the ceiling the run is in the asymptotic range. Of those, the ``finest`` runs with
+    the smallest steps (all when None) are fitted by :func:`observed_order`: the nearest to
+    the asymptotic regime. Each caller names its window, from where its round-off and its
+    reference's accuracy lie.
+
+    Parameters
+    ----------
+    step_sizes : array_like, shape (k,)
+        The steps h (s), or mean steps of adaptive runs.
+    errors : array_like, shape (k,)
+        Their errors (``inf`` or NaN for a failed run).
+    window : (float, float)
+        The open interval of errors that enter the fit.
+    finest : int, optional
+        Fit at most this many, those with the smallest steps.
+    minimum : int
+        The fewest distinct step sizes a fit needs (at least 2).
+
+    Returns
+    -------
+    OrderFit or None
+        None when fewer than ``minimum`` distinct steps are left.
+
+    Examples
+    --------
+    >>> fit = fit_order([0.1, 0.05, 0.025, 0.0125], [1e-4, 6.25e-6, 3.90625e-7, 1e-16],
+    ...                 window=(1e-13, 1.0))
+    >>> round(fit.order, 12), fit.points
+    (4.0, 3)
+    """
+    h = np.asarray(step_sizes, dtype=float)
+    e = np.asarray(errors, dtype=float)
+    if e.shape != h.shape:
+        raise _checks.fail("errors", errors, f"one value per step size ({h.size})")
+    if minimum < 2:
+        raise _checks.fail("minimum", minimum, "at least 2 (a slope needs two steps)")
+    with np.errstate(invalid="ignore"):
+        inside = np.isfinite(e) & (e > window[0]) & (e < window[1])
+    by_step = np.argsort(h, kind="stable")
+    chosen = by_step[inside[by_step]][:finest]
+    if np.unique(h[chosen]).size < minimum:
+        return None
+    used = np.zeros(h.shape, dtype=bool)
+    used[chosen] = True
+    order = observed_order(h[used], e[used])
+    return OrderFit(order, h[used], e[used], used)
 
 
 def _times(t: ArrayLike) -> tuple[np.ndarray, bool]:

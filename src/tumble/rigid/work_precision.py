@@ -9,18 +9,19 @@ exact attitude (:func:`tumble.exact.free_body_rotation`). The result is a list o
 
 from __future__ import annotations
 
-import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
+from functools import partial
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble import _checks
-from tumble.exact import free_body_rotation
+from tumble.exact import free_body_rotation, study
 from tumble.rigid.body import RigidBody
-from tumble.rigid.methods import get_method
+from tumble.rigid.methods import Method, get_method
 from tumble.rigid.simulation import simulate
+from tumble.rigid.trajectory import Trajectory
 
 STEPS = (50, 100, 200, 400, 800)
 """Default step counts of the fixed-step methods over ``[0, t_end]``."""
@@ -84,10 +85,11 @@ def work_precision(
 
         e = \\lVert R(T) - R_{\\text{exact}}(T) \\rVert_F
 
-    with ``R_exact`` from :func:`tumble.exact.free_body_rotation` (``R(0) = I``). Before any
-    timing every method runs once over two tiny steps, so numba's compilation (the
-    fixed-step methods run in the compiled kernels) is not counted; the time of a run is
-    the best of ``repeat`` (``time.perf_counter``), the least disturbed by other work.
+    with ``R_exact`` from :func:`tumble.exact.free_body_rotation` (``R(0) = I``). The runs
+    go through :func:`tumble.exact.study`: before any timing each method runs once over two
+    tiny steps, so numba's compilation (the fixed-step methods run in the compiled kernels)
+    is not counted; the time of a run is the best of ``repeat`` (``time.perf_counter``), the
+    least disturbed by other work.
     Every method runs compiled (the adaptive ones in the compiled adaptive loop), so the
     times compare methods; so do the step counts.
 
@@ -128,37 +130,43 @@ def work_precision(
     ([10, 20], True)
     """
     specs, t_end, repeat = _check(methods, t_end, repeat)
-    exact = free_body_rotation(body.inertia, omega0, t_end)
-    for spec in specs:  # warm-up: compile the kernels before any timing
-        step = {"rtol": 1e-3, "h": None} if spec.adaptive else {"rtol": None, "h": 1e-3}
-        simulate(body, 2e-3, method=spec.name, omega0=omega0, h=step["h"], rtol=step["rtol"])
+    reference = free_body_rotation(body.inertia, omega0, t_end)
     points = []
     for spec in specs:
         if spec.adaptive:
             settings = _checks.values("tolerances", tolerances, positive=True).tolist()
-            runs = [{"rtol": tol} for tol in settings]
         else:
             settings = [t_end / n for n in _step_counts(steps)]
-            runs = [{"h": h} for h in settings]
-        for setting, options in zip(settings, runs, strict=True):
-            seconds, run = _timed(repeat, body, t_end, spec.name, omega0, options)
-            error = float(np.linalg.norm(run.R[-1] - exact)) if run.status == 0 else np.inf
-            points.append(
-                WorkPrecisionPoint(spec.name, setting, run.n_steps, run.n_rejected, seconds, error)
-            )
+
+        trials = study(partial(_run, body, t_end, spec, omega0), settings,
+                       partial(_error, reference), repeat=repeat,
+                       warm_up=partial(_warm_up, body, spec, omega0))  # fmt: skip
+        points += [
+            WorkPrecisionPoint(spec.name, trial.setting, trial.result.n_steps,
+                               trial.result.n_rejected, trial.seconds, trial.error)
+            for trial in trials
+        ]  # fmt: skip
     return points
 
 
-def _timed(repeat: int, body, t_end, method, omega0, options):
-    """Best wall time of ``repeat`` runs, and the last run's trajectory."""
-    best = np.inf
-    for _ in range(repeat):
-        start = time.perf_counter()
-        run = simulate(
-            body, t_end, method=method, omega0=omega0, record_every=_KEEP_ENDS, **options
-        )
-        best = min(best, time.perf_counter() - start)
-    return best, run
+def _run(
+    body: RigidBody, t_end: float, spec: Method, omega0: ArrayLike, setting: float
+) -> Trajectory:
+    """One run recording only its ends: ``h = setting``, or ``rtol = setting`` (adaptive)."""
+    return simulate(body, t_end, method=spec.name, omega0=omega0, record_every=_KEEP_ENDS,
+                    h=None if spec.adaptive else setting,
+                    rtol=setting if spec.adaptive else None)  # fmt: skip
+
+
+def _warm_up(body: RigidBody, spec: Method, omega0: ArrayLike) -> None:
+    """Two tiny steps: numba compiles the method's kernels before any timing."""
+    step = {"rtol": 1e-3, "h": None} if spec.adaptive else {"rtol": None, "h": 1e-3}
+    simulate(body, 2e-3, method=spec.name, omega0=omega0, h=step["h"], rtol=step["rtol"])
+
+
+def _error(reference: np.ndarray, run: Trajectory) -> float:
+    """``‖R(T) − R_exact(T)‖_F``; inf for a run that stopped on a non-finite state."""
+    return float(np.linalg.norm(run.R[-1] - reference)) if run.status == 0 else np.inf
 
 
 def _check(methods, t_end, repeat):

@@ -4,8 +4,9 @@ Hairer, Lubich & Wanner's test body I = diag(2, 1, 2/3) kg m² (it violates the 
 inequality, hence ``allow_unphysical=True``) starts at R(0) = Id with the world angular
 momentum L = (cos 1.1, 0, sin 1.1) kg m²/s and runs to T = 10 s. The reference is the exact
 attitude :func:`tumble.exact.free_body_rotation`; the error of a run is ``‖R(T) − R_exact(T)‖_F``
-and the observed order is the least-squares slope of log(error) against log(h)
-(:func:`tumble.exact.observed_order`).
+and the observed order is the least-squares slope of log(error) against log(h) through the
+errors above round-off (:func:`tumble.exact.fit_order`; the runs through
+:func:`tumble.exact.study`).
 
 The point of the study is seed 002's "RK4" (``seed-rk4``): its stages live in the Lie algebra
 but leave out the ``dexp⁻¹`` correction of Runge–Kutta–Munthe-Kaas. The neglected terms are
@@ -22,6 +23,7 @@ E. Hairer, C. Lubich, G. Wanner, Geometric Numerical Integration, 2nd ed., Sprin
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from functools import partial
 
@@ -30,7 +32,7 @@ from numpy.typing import ArrayLike
 
 from tumble import _checks, exact
 from tumble.io import ScenarioResult
-from tumble.rigid import METHODS, RigidBody, simulate
+from tumble.rigid import METHODS, RigidBody, Trajectory, simulate
 from tumble.scenarios._common import fixed_step_methods, method_names
 from tumble.viz import rigid
 
@@ -94,12 +96,14 @@ def final_errors(method: str, step_sizes: ArrayLike, *, t_end: float = 10.0) -> 
     _check_fixed_step("method", method, method)
     body = RigidBody(1.0, INERTIA, allow_unphysical=True)
     reference = exact.free_body_rotation(INERTIA, body.inertia_inverse @ L0, t_end)
-    errors = []
-    for h in np.asarray(step_sizes, dtype=float).tolist():
-        steps = max(1, round(t_end / h))
-        run = simulate(body, t_end, method=method, h=h, L0=L0, record_every=steps)
-        errors.append(np.linalg.norm(run.R[-1] - reference))
-    return np.array(errors)
+
+    def run(h: float) -> Trajectory:
+        return simulate(
+            body, t_end, method=method, h=h, L0=L0, record_every=max(1, round(t_end / h))
+        )
+
+    trials = exact.study(run, step_sizes, lambda run: np.linalg.norm(run.R[-1] - reference))
+    return np.array([trial.error for trial in trials])
 
 
 def run(
@@ -211,30 +215,33 @@ def _check_fixed_step(argument: str, value, method) -> None:
     )
 
 
+def _fit(step_sizes: np.ndarray, errors: np.ndarray) -> exact.OrderFit | None:
+    """:func:`tumble.exact.fit_order` through every error above :data:`ROUND_OFF_FLOOR`."""
+    return exact.fit_order(step_sizes, errors, window=(ROUND_OFF_FLOOR, math.inf))
+
+
 def _study(method: str, step_sizes: np.ndarray, t_end: float) -> dict:
     errors = final_errors(method, step_sizes, t_end=t_end)
     finest = np.argsort(step_sizes)[:2]
-    above = errors > ROUND_OFF_FLOOR
-    left_out = int(np.count_nonzero(~above))
-    order, note = None, None
-    if np.unique(step_sizes[above]).size >= 2:
-        order = exact.observed_order(step_sizes[above], errors[above])
-        if left_out:
-            note = (
-                f"{left_out} of {errors.size} errors are at round-off (≤ {ROUND_OFF_FLOOR:g}) "
-                "and are left out of the fit"
-            )
-    else:
+    fit = _fit(step_sizes, errors)
+    left_out = errors.size - (0 if fit is None else fit.points)
+    note = None
+    if fit is None:
         note = (
             f"{left_out} of {errors.size} errors are at round-off (≤ {ROUND_OFF_FLOOR:g}): "
             "too few above it for an order; use fewer steps (larger h), e.g. step_counts="
             f"{HIGH_ORDER_STEP_COUNTS} for rkmk8"
         )
+    elif left_out:
+        note = (
+            f"{left_out} of {errors.size} errors are at round-off (≤ {ROUND_OFF_FLOOR:g}) "
+            "and are left out of the fit"
+        )
     return {
         "claimed_order": CLAIMED_ORDERS.get(method),
-        "observed_order": order,
+        "observed_order": None if fit is None else fit.order,
         "errors": errors.tolist(),
-        "fitted": int(np.count_nonzero(above)) if order is not None else 0,
+        "fitted": 0 if fit is None else fit.points,
         "note": note,
         "last_halving_ratio": float(errors[finest[1]] / errors[finest[0]]),
     }
@@ -246,13 +253,12 @@ def _plotted(method: str, step_sizes: np.ndarray, result: dict) -> tuple:
     A method at round-off has no slope; its errors are drawn on a flat line (slope 0).
     """
     errors = np.array(result["errors"])
-    if result["observed_order"] is None:
+    fit = _fit(step_sizes, errors)
+    if fit is None:
         return f"{method} (at round-off, no order)", step_sizes, errors, 0.0
-    above = errors > ROUND_OFF_FLOOR
-    label = (
-        method if above.all() else f"{method} ({np.count_nonzero(~above)} at round-off not shown)"
-    )
-    return label, step_sizes[above], errors[above], result["observed_order"]
+    left_out = errors.size - fit.points
+    label = method if not left_out else f"{method} ({left_out} at round-off not shown)"
+    return label, step_sizes[fit.used], errors[fit.used], fit.order
 
 
 def free_body() -> tuple[RigidBody, np.ndarray]:
