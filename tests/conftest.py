@@ -16,16 +16,16 @@ settings.register_profile("thorough", max_examples=2000, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 
-
 def pytest_report_header(config):
     """The arithmetic this run uses: what `make portability` varies, shown in the header."""
     import numba
     from numpy._core import _multiarray_umath as umath
 
     found = [f for f in umath.__cpu_dispatch__ if umath.__cpu_features__.get(f)]
+    features = numba.config.CPU_FEATURES
     return [
         f"numba target: {numba.config.CPU_NAME or 'host'} "
-        f"(features {numba.config.CPU_FEATURES if numba.config.CPU_FEATURES is not None else 'host'})",
+        f"(features {'host' if features is None else repr(features)})",
         f"numpy SIMD dispatch: baseline {' '.join(umath.__cpu_baseline__)}, "
         f"dispatched {' '.join(found) or 'none'}",
     ]
