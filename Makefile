@@ -46,6 +46,11 @@ portability: $(STAMP)
 	NUMBA_CPU_NAME=generic NPY_DISABLE_CPU_FEATURES="$$($(NPY_DISPATCHED))" \
 		$(BIN)/python -m pytest -p no:cacheprovider $(PORTABILITY_TESTS)
 
+# The truth suite's nightly run: random bodies, spins, loads and steps, many examples each
+# (`make test` runs a fixed, deterministic sample of the same tests).
+truth: $(STAMP)
+	HYPOTHESIS_PROFILE=thorough $(BIN)/python -m pytest -p no:cacheprovider tests/truth
+
 browser:
 	@command -v chromium >/dev/null && command -v chromedriver >/dev/null \
 		|| (apt-get update -qq && DEBIAN_FRONTEND=noninteractive \
