@@ -77,7 +77,6 @@ from tumble.report_card.measure import (
 )
 from tumble.report_card.peers import CLAIMS, Row, Sampled, method_row, rows, run_row
 from tumble.report_card.problems import (
-    DIPOLE,
     PROBLEM_T,
     SWEEP_T,
     Problem,
@@ -92,7 +91,6 @@ __all__ = [
     "ASYMPTOTIC",
     "BOUNDED_SLOPE",
     "CLAIMS",
-    "DIPOLE",
     "FIT_POINTS",
     "FORCED_FLOOR",
     "LONG_H",
