@@ -22,7 +22,6 @@ import os
 import numpy as np
 from hypothesis import HealthCheck, settings
 from hypothesis import strategies as st
-
 from truth_reference import sorting_rotation
 
 FINITE = {"allow_nan": False, "allow_infinity": False}

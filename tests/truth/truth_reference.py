@@ -370,3 +370,131 @@ def free_body_flips(moments: tuple, omega0: tuple, t_end: float) -> FlipTruth:
                 shift = max(shift, float(abs(near - last)))
         times = np.array([float(t) for t in flips])
         return FlipTruth(times, float(last), math.sqrt(3.0) * shift)
+
+
+@dataclass(frozen=True)
+class Loads:
+    """Constant loads on a body of unit mass, in the terms both tumble and the reference
+    take: a world torque (N m), a body-fixed dipole ``moment`` (A m², body) in a world
+    ``field`` (T), a world ``force`` (N) at a body ``point`` (m, from the centre of mass),
+    and gravity ``g`` (m/s², world) about a body ``pivot`` (m, from the centre of mass).
+    Zero vectors (and ``pivot=None``) are absent loads."""
+
+    torque: tuple = (0.0, 0.0, 0.0)
+    moment: tuple = (0.0, 0.0, 0.0)
+    field: tuple = (0.0, 0.0, 0.0)
+    force: tuple = (0.0, 0.0, 0.0)
+    point: tuple = (0.0, 0.0, 0.0)
+    g: tuple = (0.0, 0.0, 0.0)
+    pivot: tuple | None = None
+
+    def inertia(self, moments: tuple) -> np.ndarray:
+        """The inertia the body turns with: about the pivot (parallel axis) if there is one."""
+        inertia = np.diag(moments)
+        if self.pivot is None:
+            return inertia
+        p = np.array(self.pivot)
+        return inertia + (p @ p) * np.eye(3) - np.outer(p, p)
+
+    def body_torque(self, R: np.ndarray) -> np.ndarray:
+        """The torque in body axes at the attitude ``R``: ``Rᵀτ + μ × RᵀB + r × RᵀF``, and
+        gravity's ``(−p) × Rᵀg`` about the pivot (unit mass)."""
+        torque = R.T @ np.array(self.torque)
+        torque += np.cross(self.moment, R.T @ np.array(self.field))
+        torque += np.cross(self.point, R.T @ np.array(self.force))
+        if self.pivot is not None:
+            torque += np.cross(-np.array(self.pivot), R.T @ np.array(self.g))
+        return torque
+
+
+def _quaternion_rotation(q: np.ndarray) -> np.ndarray:
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])  # fmt: skip
+
+
+def _quaternion(R: np.ndarray) -> np.ndarray:
+    from scipy.spatial.transform import Rotation
+
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    return np.array([w, x, y, z])
+
+
+def _euler_field(inertia: np.ndarray, loads: Loads):
+    """Euler's equations in the body frame with a quaternion:
+    ``I ω̇ = (Iω) × ω + τ_body(R)``, ``q̇ = ½ q ⊗ (0, ω)``."""
+    inverse = np.linalg.inv(inertia)
+
+    def field(t, y):
+        q, w = y[:4], y[4:]
+        R = _quaternion_rotation(q)
+        dw = inverse @ (np.cross(inertia @ w, w) + loads.body_torque(R))
+        q0, q1, q2, q3 = q
+        dq = 0.5 * np.array([
+            -q1 * w[0] - q2 * w[1] - q3 * w[2],
+            q0 * w[0] + q2 * w[2] - q3 * w[1],
+            q0 * w[1] + q3 * w[0] - q1 * w[2],
+            q0 * w[2] + q1 * w[1] - q2 * w[0],
+        ])  # fmt: skip
+        return np.concatenate([dq, dw])
+
+    return field
+
+
+REFERENCE_RTOL = 1e-13
+"""DOP853's tolerance for the forced reference (its error measured in the tests: 1e-12 …
+1e-11 relative over a few turns)."""
+
+
+def forced_rotation(moments: tuple, omega0: tuple, R0: np.ndarray, loads: Loads,
+                    t_end: float, rtol: float = REFERENCE_RTOL,
+                    method: str = "DOP853") -> np.ndarray:  # fmt: skip
+    """``R(t_end)`` of a forced body by scipy's DOP853 (Hairer, Nørsett & Wanner §II.10), or
+    another of ``solve_ivp``'s methods, on Euler's equations in the body frame with a
+    quaternion; ``atol = rtol·1e-3`` in units of the state (1 and |ω₀|)."""
+    from scipy.integrate import solve_ivp
+
+    y0 = np.concatenate([_quaternion(R0), omega0])
+    field = _euler_field(loads.inertia(moments), loads)
+    scale = float(np.linalg.norm(omega0))
+    atol = rtol * 1e-3 * np.array([1, 1, 1, 1, scale, scale, scale])
+    solution = solve_ivp(field, (0.0, t_end), y0, method=method, rtol=rtol, atol=atol)
+    assert solution.success, solution.message
+    return _quaternion_rotation(solution.y[:4, -1])
+
+
+@dataclass(frozen=True)
+class ForcedTruth:
+    """What DOP853 says about one forced problem.
+
+    Attributes
+    ----------
+    R : ndarray, shape (3, 3)
+        The attitude at ``t_end``, at rtol 1e-13.
+    error : float
+        A bound on its error: its change from rtol 1e-11 (DOP853's error falls with rtol).
+    sensitivity : float
+        How far ``R(t_end)`` moves per unit relative change of ω₀ (a finite difference of
+        1e-7 along (1, −2, 3)/√14, times √3 for the other directions).
+    """
+
+    R: np.ndarray
+    error: float
+    sensitivity: float
+
+
+@functools.lru_cache(maxsize=256)
+def forced_body(moments: tuple, omega0: tuple, R0: tuple, loads: Loads, t_end: float):
+    """The :class:`ForcedTruth` of ``diag(moments)`` spun at ``omega0`` from ``R0`` under
+    ``loads`` (unit mass), at ``t_end``."""
+    R0 = np.array(R0)
+    omega0 = np.array(omega0)
+    R = forced_rotation(moments, omega0, R0, loads, t_end)
+    rough = forced_rotation(moments, omega0, R0, loads, t_end, rtol=1e-11)
+    nudge = 1e-7 * np.linalg.norm(omega0) * np.array([1.0, -2.0, 3.0]) / math.sqrt(14.0)
+    moved = forced_rotation(moments, omega0 + nudge, R0, loads, t_end)
+    sensitivity = math.sqrt(3.0) * float(np.linalg.norm(moved - R)) / 1e-7
+    return ForcedTruth(R, float(np.linalg.norm(R - rough)) + 16 * ULP, sensitivity)
