@@ -92,6 +92,7 @@ def sign_changes(x: np.ndarray) -> int:
     steps_per_period=st.floats(1.0, 200.0),
 )
 @example(problem=REPRODUCER, periods=200.0 / 175.123, steps_per_period=1751.23)
+@example(problem=REPRODUCER, periods=200.0 / 175.123, steps_per_period=37 * 175.123 / 200.0)
 def test_exact_flow_stays_within_the_round_off_floor(method, problem, periods, steps_per_period):
     period = orbit_period(problem.moments, problem.omega0)
     t_end = periods * period
@@ -148,6 +149,24 @@ def flow_starts(method: str, h: float) -> tuple[float, ...]:
     problem=free_problems(),
     share=st.floats(1e-3, 0.5),
 )
+@example(  # Δ/|L|² = 4.6e-13: yoshida4's long substeps (68 800 floors on today's code)
+    problem=FreeProblem((0.3497322746927686, 11.653623188789162, 3.9683230699916914),
+                        (0.33824075395556874, 0.04020708846397631, 0.7371130592313846),
+                        np.eye(3), "found"),
+    share=0.3887304115042434,
+)  # fmt: skip
+@example(  # Δ/|L|² = −1.0e-14: 150 floors for each method on today's code
+    problem=FreeProblem((1.7089656177416848, 1.8417391559161795, 2.9205634826232183),
+                        (-0.31790050723270713, 0.36428213214400007, -0.08531098513192331),
+                        np.eye(3), "found"),
+    share=0.3279739441401287,
+)  # fmt: skip
+@example(  # Δ/|L|² = −1.0e-14, a short step near the middle axis: 10–13 floors today
+    problem=FreeProblem((1.0005511603255672, 1.001, 1.0),
+                        (-0.27287267147883626, 0.0007661407394722711, 0.0006917240162547146),
+                        np.eye(3), "found"),
+    share=0.001,
+)  # fmt: skip
 def test_one_step_of_the_exact_flow_keeps_the_body_rate_to_round_off(method, problem, share):
     """One step of ``share`` of a period: ω(h) within ``FLOOR_ULPS`` of its floor, the ulp
     of ω plus what an ulp of the momentum moves it by, summed over the step's flows."""
