@@ -129,8 +129,9 @@ def test_exact_flow_flips_as_often_as_the_closed_form(method, problem, periods, 
     run = simulate(problem.body, t_end, method=method, h=h, omega0=problem.omega0, R0=problem.R0)
     counted = sign_changes(run.omega_body[:, problem.middle])
     n = flows(method, run.n_steps)
-    blur = FLOOR_ULPS * n * truth.shift  # how far round-off may move the flip nearest T
-    allowed = int(abs(t_end - truth.nearest) <= blur)  # that flip may fall either side of T
+    blur = FLOOR_ULPS * n * truth.shift  # how far round-off may move the flips near T
+    # the flip nearest T may fall either side of it; a blur past half a period blurs more
+    allowed = int(abs(t_end - truth.nearest) <= blur) + int(2 * blur // (period / 2))
     assert abs(counted - len(truth.times)) <= allowed, (
         f"{method}: {counted} flips, the closed form {len(truth.times)} in {t_end:.4g} s "
         f"(at {np.round(truth.times, 3)}); h = {h:.3g} s, {problem}"

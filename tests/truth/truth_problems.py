@@ -20,7 +20,7 @@ import math
 import os
 
 import numpy as np
-from hypothesis import HealthCheck, settings
+from hypothesis import HealthCheck, Phase, settings
 from hypothesis import strategies as st
 from truth_reference import sorting_rotation
 
@@ -106,8 +106,9 @@ NIGHTLY = os.environ.get("HYPOTHESIS_PROFILE") == "thorough"
 
 def sample(default: int, nightly: int) -> settings:
     """Hypothesis settings: ``default`` examples drawn deterministically (the same ones on
-    every run and machine: ``make test``), or ``nightly`` random ones under the thorough
-    profile."""
+    every run and machine: ``make test``) and reported as drawn, without shrinking (a
+    failure's message names its problem; shrinking one costs minutes of mpmath), or
+    ``nightly`` random ones, shrunk, under the thorough profile."""
     quiet = [HealthCheck.too_slow, HealthCheck.filter_too_much, HealthCheck.data_too_large]
     if NIGHTLY:
         return settings(max_examples=nightly, deadline=None, suppress_health_check=quiet)
@@ -117,5 +118,5 @@ def sample(default: int, nightly: int) -> settings:
         database=None,
         deadline=None,
         suppress_health_check=quiet,
-        print_blob=True,
+        phases=(Phase.explicit, Phase.generate),
     )

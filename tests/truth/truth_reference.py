@@ -397,13 +397,14 @@ class Loads:
         return inertia + (p @ p) * np.eye(3) - np.outer(p, p)
 
     def body_torque(self, R: np.ndarray) -> np.ndarray:
-        """The torque in body axes at the attitude ``R``: ``Rᵀτ + μ × RᵀB + r × RᵀF``, and
-        gravity's ``(−p) × Rᵀg`` about the pivot (unit mass)."""
+        """The torque in body axes at the attitude ``R``, about the centre of mass or the
+        pivot ``p``: ``Rᵀτ + μ × RᵀB + (r − p) × RᵀF`` and gravity's ``(−p) × Rᵀg`` (unit
+        mass; the pivot's reaction acts at the pivot, with no torque about it)."""
+        origin = np.zeros(3) if self.pivot is None else np.array(self.pivot)
         torque = R.T @ np.array(self.torque)
         torque += np.cross(self.moment, R.T @ np.array(self.field))
-        torque += np.cross(self.point, R.T @ np.array(self.force))
-        if self.pivot is not None:
-            torque += np.cross(-np.array(self.pivot), R.T @ np.array(self.g))
+        torque += np.cross(np.array(self.point) - origin, R.T @ np.array(self.force))
+        torque += np.cross(-origin, R.T @ np.array(self.g))
         return torque
 
 
