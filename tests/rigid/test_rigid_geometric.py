@@ -386,7 +386,7 @@ def test_exact_flow_constants_agree_with_the_elliptic_module():
     assert kernels.SYMMETRY_RTOL == _elliptic.SYMMETRY_RTOL
     assert kernels.SEPARATRIX_RTOL == _elliptic.SEPARATRIX_RTOL
     assert kernels.M1_MIN == _elliptic.M1_MIN and kernels.AGM_MAX_STEPS == _elliptic.AGM_MAX_STEPS
-    assert kernels.M1_SERIES == _elliptic.M1_SERIES
+    assert kernels.M1_SERIES == _elliptic.M1_SERIES and kernels.NU_SPLIT == _elliptic.NU_SPLIT
 
 
 def test_compiled_carlson_integrals_match_scipy():
