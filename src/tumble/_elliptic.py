@@ -51,6 +51,9 @@ M1_MIN = 1e-300
 #: ``ε √((1 + k')/k')``, no more than 2ε from k' = 1/3 up. Below, the series (whose ratio
 #: of terms, the complementary nome, is at most 7.4e-3 there) keeps every function to a few ε.
 M1_SERIES = 1.0 / 9.0
+#: The precession integral Π(−ν) is taken as F + P below this ν, as P alone from it up
+#: (:func:`legendre_integrals`).
+NU_SPLIT = 1.0
 #: Largest |I − Iᵀ| accepted for a full inertia tensor, relative to max |I|.
 SYMMETRIC_RTOL = 1e-10
 #: Largest |RᵀR − Id| accepted for an initial attitude.
@@ -58,22 +61,43 @@ ROTATION_ATOL = 1e-10
 
 
 def legendre_integrals(
-    s: np.ndarray | float, c2: np.ndarray | float, d2: np.ndarray | float, nu: float
+    s: np.ndarray | float, c2: np.ndarray | float, d2: np.ndarray | float, nu: float, m: float
 ) -> tuple[np.ndarray, np.ndarray]:
-    """``F(φ|m)`` and ``Π(−ν; φ|m)`` for ``|φ| ≤ π/2`` from ``s ∝ sin φ``, ``c2 ∝ cos²φ`` and
-    ``d2 ∝ 1 − m sin²φ``, all scaled by one factor (``s² + c2`` is its square).
+    """``F(φ|m)`` and the part ``P`` of ``Π(−ν; φ|m)`` that is not F, for ``|φ| ≤ π/2`` from
+    ``s ∝ sin φ``, ``c2 ∝ cos²φ`` and ``d2 ∝ 1 − m sin²φ``, all scaled by one factor
+    (``s² + c2`` is its square): ``Π = F + P`` when ``ν < 1`` (:func:`keeps_first`), ``Π = P``
+    from ``ν = 1`` up.
 
     DLMF 19.25.5 and 19.25.14 with R_F and R_J made homogeneous (``R_F(λx, λy, λz) =
     R_F(x, y, z)/√λ``, ``R_J`` as ``λ^{-3/2}``): ``F = s R_F(c2, d2, r2)``, ``Π(n) = F + (n/3)
     s³ R_J(c2, d2, r2, r2 − n s²)`` with ``r2 = s² + c2``. Taking cn² and dn² themselves, never
     an angle, keeps the relative accuracy of a small cn or dn: the integrals' derivatives in
     φ grow like 1/dn, those in cn² and dn² do not.
+
+    The flow wants a difference of Π over a step, ``|L|(C − A)/(ACλ) [Π(u) − Π(u0)]``, and
+    on a near-degenerate body (B − A or C − B small) λ is small while Π is of the size of
+    ``u ≤ 3K``: Π's absolute round-off, ε K, became ε K/λ rad of precession a step. So F,
+    whose difference is λh exactly (``F(am u) = u``), is kept out: for ``ν < 1``
+    ``P = −(ν/3) s³ R_J(c2, d2, r2, r2 + ν s²)``, of the size ν u; for ``ν ≥ 1`` DLMF 19.7.9
+    with ``n = −ν``, ``m/n = −m/ν`` (its R_C term made elementary, ``g = √((1 + ν)(1 + m/ν))``):
+    ``Π(−ν) = (m/ν)/3 s³ R_J(c2, d2, r2, r2 + (m/ν) s²) + atan2(g s √r2, √(c2 d2))/g``, of the
+    size ``u/ν + π/(2g)``.
     """
     from scipy.special import elliprf, elliprj  # 0.18 s to import: only where it is needed
 
     r2 = s * s + c2
     first = s * elliprf(c2, d2, r2)
-    return first, first - nu / 3.0 * s * s * s * elliprj(c2, d2, r2, r2 + nu * s * s)
+    if keeps_first(nu):
+        return first, -nu / 3.0 * s * s * s * elliprj(c2, d2, r2, r2 + nu * s * s)
+    n = m / nu
+    g = np.sqrt((1.0 + nu) * (1.0 + n))
+    turn = np.arctan2(g * s * np.sqrt(r2), np.sqrt(c2 * d2)) / g
+    return first, n / 3.0 * s * s * s * elliprj(c2, d2, r2, r2 + n * s * s) + turn
+
+
+def keeps_first(nu: float) -> bool:
+    """Whether ``Π(−ν) = F + P`` (ν < 1) or ``Π = P`` (:func:`legendre_integrals`)."""
+    return nu < NU_SPLIT
 
 
 def complete_first(m1: float) -> float:
@@ -83,11 +107,16 @@ def complete_first(m1: float) -> float:
     return float(elliprf(0.0, m1, 1.0))
 
 
-def complete_third(n: float, m1: float) -> float:
-    """Π(n|m) = R_F(0, m1, 1) + (n/3) R_J(0, m1, 1, 1 − n)."""
-    from scipy.special import elliprf, elliprj
+def complete_part(nu: float, m: float, m1: float) -> float:
+    """P of the complete ``Π(−ν|m)`` (:func:`legendre_integrals` at φ = π/2):
+    ``−(ν/3) R_J(0, m1, 1, 1 + ν)`` for ν < 1, else ``(m/ν)/3 R_J(0, m1, 1, 1 + m/ν) + π/(2g)``."""
+    from scipy.special import elliprj
 
-    return float(elliprf(0.0, m1, 1.0) + n / 3.0 * elliprj(0.0, m1, 1.0, 1.0 - n))
+    if keeps_first(nu):
+        return float(-nu / 3.0 * elliprj(0.0, m1, 1.0, 1.0 + nu))
+    n = m / nu
+    g = np.sqrt((1.0 + nu) * (1.0 + n))
+    return float(n / 3.0 * elliprj(0.0, m1, 1.0, 1.0 + n) + 0.5 * np.pi / g)
 
 
 def jacobi(u: np.ndarray, m: float, m1: float) -> tuple[np.ndarray, ...]:
@@ -190,7 +219,7 @@ class EllipticMotion:
     m: float
     m1: float
     u0: float
-    start: float  # Π(−ν; am u0 | m), taken with u0 from ω(0)'s own components
+    start: float  # P(am u0) of Π(−ν; am u0 | m) (legendre_integrals), u0 from ω(0) itself
 
     @property
     def quarter(self) -> float:
@@ -228,15 +257,19 @@ class EllipticMotion:
         ∫ du / (1 + ν sn²u) = Π(−ν; am u | m); + and ν = C(B − A)/(A(C − B)) in regime C,
         − and ν = A(C − B)/(C(B − A)) in regime A (:func:`precession_nu`). Π is taken from
         sn, cn², dn² (:func:`legendre_integrals`), never from am, whose absolute error near
-        π/2 would be amplified by 1/dn.
+        π/2 would be amplified by 1/dn; and for ν < 1 its part F, whose difference is λt,
+        is not taken at all (for ν ≥ 1 Π has no F part): the rest is of the size
+        ``min(ν, 1/√ν) u``, so its round-off stays small when λ is (a near-degenerate body).
         """
         a, _, c = self.moments
         nu, weight = precession_nu(self.moments, self.pole), (1.0 if self.pole == 2 else -1.0)
         sn, cn, dn, j = self.functions(t)
-        pi_t = legendre_integrals(sn, cn * cn, dn * dn, nu)[1]
-        pi_t = pi_t + j * 2.0 * complete_third(-nu, self.m1)
+        part = legendre_integrals(sn, cn * cn, dn * dn, nu, self.m)[1]
+        part = part + j * 2.0 * complete_part(nu, self.m, self.m1)
         scale = weight * momentum * (c - a) / (a * c * self.rate)
-        return momentum * t / self.moments[self.pole] + scale * (pi_t - self.start)
+        if keeps_first(nu):  # |L|/I_pole ± |L|(C − A)/(AC) = |L|/I_other
+            return momentum * t / self.moments[2 - self.pole] + scale * (part - self.start)
+        return momentum * t / self.moments[self.pole] + scale * (part - self.start)
 
 
 def elliptic_motion(moments: np.ndarray, omega0: np.ndarray) -> EllipticMotion | None:
@@ -271,25 +304,26 @@ def elliptic_motion(moments: np.ndarray, omega0: np.ndarray) -> EllipticMotion |
     other = 2 - pole
     cn0 = omega0[other] / amplitudes[other] if amplitudes[other] > 0 else 1.0
     sn0 = sign * w_b / a_b if a_b > 0 else 0.0
-    u0, start = start_phase(sn0, cn0, m1, precession_nu(moments, pole))
+    u0, start = start_phase(sn0, cn0, m, m1, precession_nu(moments, pole))
     return EllipticMotion(moments, amplitudes, pole, sign, rate, m, m1, u0, start)
 
 
-def start_phase(sn0: float, cn0: float, m1: float, nu: float) -> tuple[float, float]:
-    """``u0`` and ``Π(−ν; am u0 | m)`` for ``sn u0 = sn0``, ``cn u0 = cn0`` as read off ω(0).
+def start_phase(sn0: float, cn0: float, m: float, m1: float, nu: float) -> tuple[float, float]:
+    """``u0`` and P of ``Π(−ν; am u0 | m)`` (:func:`legendre_integrals`) for ``sn u0 = sn0``,
+    ``cn u0 = cn0`` as read off ω(0).
 
     :func:`legendre_integrals` of ``(sn0, cn0², cn0² + m1 sn0²)``: the components themselves,
     so a small cn0 or dn0 (a spin near the middle axis) keeps its relative accuracy, where
     ``atan2`` then ``cos`` would keep only an absolute ε and lose a factor 1/dn0 in u0. When
-    ``cn0 < 0`` the point is the half period on: ``u0 = ±2K + F``, ``Π = ±2Π(−ν|m) + Π``.
+    ``cn0 < 0`` the point is the half period on: ``u0 = ±2K + F``, ``P = ±2P(π/2) + P``.
     """
     half = 0.0 if cn0 >= 0.0 else (1.0 if sn0 >= 0.0 else -1.0)
     s, c = (sn0, cn0) if cn0 >= 0.0 else (-sn0, -cn0)
-    first, third = legendre_integrals(s, c * c, c * c + m1 * s * s, nu)
+    first, part = legendre_integrals(s, c * c, c * c + m1 * s * s, nu, m)
     if half:
         first = first + 2.0 * half * complete_first(m1)
-        third = third + 2.0 * half * complete_third(-nu, m1)
-    return float(first), float(third)
+        part = part + 2.0 * half * complete_part(nu, m, m1)
+    return float(first), float(part)
 
 
 @dataclass(frozen=True)

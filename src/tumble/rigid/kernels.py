@@ -707,6 +707,7 @@ _EPS = 2.220446049250313e-16
 _RF_Q = (3.0 * _EPS) ** (-1.0 / 6.0)
 _RJ_Q = (0.25 * _EPS) ** (-1.0 / 6.0)
 SYMMETRY_RTOL, SEPARATRIX_RTOL, M1_MIN, M1_SERIES = 1e-12, 2.0 * _EPS, 1e-300, 1.0 / 9.0
+NU_SPLIT = 1.0
 """As :mod:`tumble._elliptic`, which derives them (a test checks they agree)."""
 AGM_MAX_STEPS = 64
 WORK_SIZE = AGM_MAX_STEPS
@@ -826,35 +827,52 @@ def _jacobi_reduced(r, m, m1, quarter, co_quarter, work):
 
 
 @njit(**_JIT)
-def _legendre_integrals(s, c2, d2, nu):
-    """``(F(φ|m), Π(−ν; φ|m))`` from ``s, cn², dn²`` (``tumble._elliptic.legendre_integrals``)."""
+def _legendre_integrals(s, c2, d2, nu, m):
+    """``(F(φ|m), P)`` from ``s, cn², dn²``: ``Π(−ν; φ|m) = F + P`` for ``ν < 1``, ``= P``
+    from 1 up (``tumble._elliptic.legendre_integrals``)."""
     r2 = s * s + c2
     first = s * _carlson_rf(c2, d2, r2)
-    return first, first - nu / 3.0 * s * s * s * _carlson_rj(c2, d2, r2, r2 + nu * s * s)
+    if nu < NU_SPLIT:
+        return first, -nu / 3.0 * s * s * s * _carlson_rj(c2, d2, r2, r2 + nu * s * s)
+    n = m / nu
+    g = math.sqrt((1.0 + nu) * (1.0 + n))
+    turn = math.atan2(g * s * math.sqrt(r2), math.sqrt(c2 * d2)) / g
+    return first, n / 3.0 * s * s * s * _carlson_rj(c2, d2, r2, r2 + n * s * s) + turn
+
+
+@njit(**_JIT)
+def _complete_part(nu, m, m_1):
+    """P of the complete ``Π(−ν|m)`` (``tumble._elliptic.complete_part``)."""
+    if nu < NU_SPLIT:
+        return -nu / 3.0 * _carlson_rj(0.0, m_1, 1.0, 1.0 + nu)
+    n = m / nu
+    g = math.sqrt((1.0 + nu) * (1.0 + n))
+    return n / 3.0 * _carlson_rj(0.0, m_1, 1.0, 1.0 + n) + 0.5 * math.pi / g
 
 
 @njit(**_JIT)
 def _elliptic_step(wb, other_w, pole_w, amplitudes, pole, rate, m, m_1, nu, h, work):
     """The elliptic motion from ω over ``h``: ``(ω_other, ω_B, ω_pole)`` at ``h`` and the
-    precession integral ``Π(−ν; am u(h)) − Π(−ν; am u0)`` (``tumble._elliptic``'s
-    ``elliptic_motion``, ``start_phase``, ``EllipticMotion.omega`` and ``precession``)."""
+    difference over the step of the precession integral's part P (``Π(−ν; am u) = F + P``
+    for ``ν < 1``, ``= P`` from 1 up; ``tumble._elliptic``'s ``elliptic_motion``,
+    ``start_phase``, ``EllipticMotion.omega`` and ``precession``)."""
     amp_other, amp_b, amp_pole = amplitudes
     sign = 1.0 if pole_w > 0.0 else -1.0
     cn0 = other_w / amp_other if amp_other > 0.0 else 1.0
     sn0 = sign * wb / amp_b if amp_b > 0.0 else 0.0
     quarter = _carlson_rf(0.0, m_1, 1.0)
-    full = 2.0 * (quarter - nu / 3.0 * _carlson_rj(0.0, m_1, 1.0, 1.0 + nu))  # 2Π(−ν|m)
+    full = 2.0 * _complete_part(nu, m, m_1)  # P of 2Π(−ν|m)
     half = 0.0 if cn0 >= 0.0 else (1.0 if sn0 >= 0.0 else -1.0)
     s, c = (sn0, cn0) if cn0 >= 0.0 else (-sn0, -cn0)
-    u0, start = _legendre_integrals(s, c * c, c * c + m_1 * s * s, nu)
+    u0, start = _legendre_integrals(s, c * c, c * c + m_1 * s * s, nu, m)
     u0, start = u0 + 2.0 * half * quarter, start + half * full
     co_quarter = _carlson_rf(0.0, m, 1.0) if m_1 < M1_SERIES else math.inf
     u = u0 + rate * h
     j = math.floor((u + quarter) / (2.0 * quarter))
     sn, cn, dn = _jacobi_reduced(u - 2.0 * quarter * j, m, m_1, quarter, co_quarter, work)
     flip = 1.0 - 2.0 * (j - 2.0 * math.floor(0.5 * j))
-    third = _legendre_integrals(sn, cn * cn, dn * dn, nu)[1] + j * full
-    return amp_other * flip * cn, sign * amp_b * flip * sn, sign * amp_pole * dn, third - start
+    part = _legendre_integrals(sn, cn * cn, dn * dn, nu, m)[1] + j * full
+    return amp_other * flip * cn, sign * amp_b * flip * sn, sign * amp_pole * dn, part - start
 
 
 @njit(**_JIT)
@@ -989,7 +1007,13 @@ def _exact_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
             wb, wc, wa, (amp_c, amp_b, amp_a), pole, rate, m, m_1, nu, h, work
         )
     norm = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
-    phi = norm * h / moments[pole] + weight * norm * (C - A) / (A * C * rate) * integral
+    scale = weight * norm * (C - A) / (A * C * rate)
+    if separatrix:
+        phi = norm * h / moments[pole] + scale * integral
+    elif nu < NU_SPLIT:  # Π = F + P, F's part λh: |L|/I_pole ± |L|(C − A)/(AC) = |L|/I_other
+        phi = norm * h / moments[2 - pole] + scale * integral
+    else:  # Π = P
+        phi = norm * h / moments[pole] + scale * integral
     # l = I ω / |L| in the pole frame's order (q, r, p)
     if pole == 2:
         i0, i1, i2 = 0, 1, 2
