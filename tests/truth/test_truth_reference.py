@@ -70,11 +70,17 @@ def test_precession_from_the_third_integral_matches_quadrature(moments, data, sh
                 orbit.M * (A * w[0] ** 2 + B * w[1] ** 2) / (A**2 * w[0] ** 2 + B**2 * w[1] ** 2)
             )
 
-        with mp.workdps(24):
-            quadrature = mp.quad(rate, mp.linspace(0, t_end, 9))
+        # φ̇ peaks where sn or cn vanishes (τ = jK), sharply when the spin is near an axis:
+        # split there, where tanh-sinh quadrature clusters its nodes
+        first = int(mp.ceil(orbit.tau0 / orbit.K))
+        last = int(mp.floor((orbit.tau0 + orbit.rate * t_end) / orbit.K))
+        peaks = [(j * orbit.K - orbit.tau0) / orbit.rate for j in range(first, last + 1)]
+        points = [mp.mpf(0)] + [t for t in peaks if 0 < t < t_end] + [t_end]
+        quadrature, error = mp.quad(rate, points, error=True)
         closed = orbit.precession(t_end)
-        assert abs(closed - quadrature) <= mp.mpf(1e-18) * (1 + abs(quadrature)), (
-            f"φ: third integral {mp.nstr(closed, 20)}, quadrature {mp.nstr(quadrature, 20)}"
+        assert abs(closed - quadrature) <= 10 * error + mp.mpf(1e-25) * (1 + abs(quadrature)), (
+            f"φ: third integral {mp.nstr(closed, 25)}, quadrature {mp.nstr(quadrature, 25)} "
+            f"± {mp.nstr(error, 3)}"
         )
 
 
