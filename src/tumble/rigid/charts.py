@@ -133,49 +133,161 @@ def _lie_field(dynamics: Dynamics, correct: bool, Rn: np.ndarray) -> Field:
     return f
 
 
-def error_norm(error, size, Y_old, Y_new, rtol, atol):
-    """The weighted size of a step's error estimate in a chart: what rtol and atol measure.
+SEPARATRIX_SHARE = 0.1
+"""The share of ``rtol |Δ|`` by which one step may (by its error estimate) change the distance
+to the separatrix ``Δ`` (:func:`error_norm`). Per step, not per unit time as the other
+parts: the embedded estimate of a change of ``Δ`` overstates the accepted solution's by
+about ``1/(h λ)`` (orders 4 and 5 against 5 and 6; measured 20–400× near the flip), so held
+per unit time it would cost the T-handle's flipping spin 2.7× the steps for no gain. A tenth,
+per step, keeps flip times and attitudes near the separatrix within about 10× of scipy RK45 at
+equal rtol from 1e-3 to 1e-6 off the middle axis, at +19–47 % steps on the T-handle
+(docs/rigid-body.md)."""
 
-    The state has four parts, each measured in its own units, and the norm is the largest of
-    their root-mean-square norms, so that parts that carry no error (x and p of a free body,
-    L without torque: their estimates are exactly zero) cannot dilute the others:
+ROUNDING = 2.220446049250313e-16
+"""One ulp at 1 (``np.finfo(float).eps``): ``Δ = m·D m`` is not known better than
+``ROUNDING |m| |D m|``, and no step is asked to keep it better than that."""
 
-    .. math::
 
-        \\|e\\| = \\max\\Bigl(\\mathrm{rms}_{i < n_a} \\frac{e_i}{r},\\;
-        \\max_{g \\in \\{x, p, L\\}} \\mathrm{rms}_{i \\in g}
-        \\frac{e_i}{a_i + r \\max(|y_i|, |y^{new}_i|)}\\Bigr)
+def separatrix_form(inertia: np.ndarray) -> np.ndarray:
+    """``D = 1 − I₂ I⁻¹``, shape (3, 3), body frame, with ``I₂`` the middle principal moment.
 
-    * the first ``size`` numbers are the attitude's chart coordinates: for the ``lie`` chart
-      the increment ``u`` in radians, measured against ``rtol`` alone (a rotation's natural
-      size is one radian, so ``rtol = 1e-8`` asks each step's rotation to be right to 1e-8
-      rad); no ``atol`` applies to them, so it can never swamp ``rtol`` there;
-    * ``x`` (m), ``p`` (kg m/s) and ``L`` (kg m²/s) against ``atol + rtol·|y|``, Hairer's
-      mixed test, with ``atol`` of shape (9,).
+    ``Δ = m·D m = |m|² − 2 E I₂`` for the body momentum ``m = Rᵀ L`` is the signed distance
+    of the motion from the separatrix, where a spin about the middle axis turns over
+    (``Δ = 0``); the free body keeps it constant. Built in the principal frame, so that the
+    middle axis' entry is an exact zero and ``Δ`` near that axis keeps the relative accuracy
+    of the small components.
 
-    Plain scalar code: the Python steppers call it and the compiled adaptive loops of
-    :mod:`tumble.rigid.kernels` compile this same function. A NaN anywhere gives NaN (the step
-    is rejected); an error of exactly zero counts as zero even where the scale is zero.
+    Examples
+    --------
+    >>> separatrix_form(np.diag([3.0, 2.0, 1.5])).diagonal().round(4)
+    array([ 0.3333,  0.    , -0.3333])
     """
-    acc = 0.0
-    for i in range(size):
-        acc += (error[i] / rtol) ** 2
-    norm = math.sqrt(acc / size)
-    if norm != norm:  # NaN: the step is rejected
-        return norm
-    for group in range(3):
-        acc = 0.0
-        for c in range(3):
-            j = 3 * group + c
-            e = error[size + j]
-            if e != 0.0:
-                scale = atol[j] + rtol * max(abs(Y_old[j]), abs(Y_new[j]))
-                acc += (e / scale) ** 2
-        part = math.sqrt(acc / 3.0)
-        if part != part:
-            return part
-        norm = max(norm, part)
+    moments, axes = np.linalg.eigh(np.asarray(inertia, dtype=float))
+    return (axes * (1.0 - moments[1] / moments)) @ axes.T
+
+
+def error_norm(error, z, z_new, Rn, rtol, atol, separatrix, share):
+    """The weighted size of a ``lie``-chart step's error: what rtol and atol measure.
+
+    ``z = (0, x, p, L)`` and ``z_new = (u, x, p, L)`` are the step's start and end in the chart
+    at ``R_n`` (``R = R_n exp(û)``), ``error`` the tableau's estimate of ``z_new``'s error, and
+    ``share`` the step's share ``h/T`` of the run (1 without :attr:`Control.horizon
+    <tumble.ode.driver.Control.horizon>`), by which the caller divides the norm (error per
+    unit step). The norm is the largest of four parts (each a root mean square, so that a
+    part without error cannot dilute another):
+
+    * the increment ``u`` in radians against ``rtol`` alone (a rotation's natural size is one
+      radian): the attitude, its phase about ``L`` included;
+    * ``x`` (m) and ``p`` (kg m/s) against ``atol + rtol |y|``, component by component;
+    * the body momentum ``m = Rᵀ L`` (kg m²/s) against ``atol[6:] + rtol |m|``, component by
+      component in the body frame, with ``δm = m × e + Rᵀ e_L`` and ``e = dexp_{−u}(e_u)`` the
+      attitude's error in the body frame: the small components of a spin near a principal
+      axis are held to their own size, and ``atol`` bounds each in kg m²/s;
+    * on a step without torque (``L`` unchanged), the distance to the separatrix
+      ``Δ = m·D m`` (:func:`separatrix_form`), which the free body keeps: the estimated change
+      ``δΔ = 2 (D m)·δm`` against :data:`SEPARATRIX_SHARE` ``· rtol |Δ|`` per step, or
+      ``Δ``'s own rounding (:data:`ROUNDING`). Near the separatrix ``Δ`` is tiny beside
+      ``|m|²``; its relative error sets the flip times, and through them the attitude.
+
+    Plain scalar code: the Python stepper calls it and the compiled adaptive loop of
+    :mod:`tumble.rigid.kernels` compiles this same function and its helpers
+    (:data:`NORM_HELPERS`). A NaN anywhere gives NaN (the step is rejected); an error of
+    exactly zero counts as zero.
+    """
+    e0, e1, e2 = error[0], error[1], error[2]
+    norm = math.sqrt((e0 * e0 + e1 * e1 + e2 * e2) / 3.0) / rtol
+    for j in (3, 6):  # x, p
+        acc = _mixed(error[j], atol[j - 3], rtol, z[j], z_new[j])
+        acc += _mixed(error[j + 1], atol[j - 2], rtol, z[j + 1], z_new[j + 1])
+        acc += _mixed(error[j + 2], atol[j - 1], rtol, z[j + 2], z_new[j + 2])
+        norm = _largest(norm, math.sqrt(acc / 3.0))
+    u0, u1, u2 = z_new[0], z_new[1], z_new[2]
+    a, b, c = _exp_coefficients(u0 * u0 + u1 * u1 + u2 * u2)
+    m0, m1, m2 = _transpose_apply(Rn, z[9], z[10], z[11])
+    n0, n1, n2 = _transpose_apply(Rn, z_new[9], z_new[10], z_new[11])
+    n0, n1, n2 = _rotate(-a, b, u0, u1, u2, n0, n1, n2)  # m_new = exp(−û) R_nᵀ L_new
+    f0, f1, f2 = _rotate(-b, c, u0, u1, u2, e0, e1, e2)  # e = dexp_{−u}(e_u)
+    g0, g1, g2 = _transpose_apply(Rn, error[9], error[10], error[11])
+    g0, g1, g2 = _rotate(-a, b, u0, u1, u2, g0, g1, g2)  # R_newᵀ e_L
+    d0, d1, d2 = n1 * f2 - n2 * f1 + g0, n2 * f0 - n0 * f2 + g1, n0 * f1 - n1 * f0 + g2
+    acc = _mixed(d0, atol[6], rtol, m0, n0) + _mixed(d1, atol[7], rtol, m1, n1)
+    norm = _largest(norm, math.sqrt((acc + _mixed(d2, atol[8], rtol, m2, n2)) / 3.0))
+    if z[9] == z_new[9] and z[10] == z_new[10] and z[11] == z_new[11]:  # no torque
+        drift = _separatrix_drift(separatrix, m0, m1, m2, n0, n1, n2, d0, d1, d2, rtol)
+        norm = _largest(norm, share * drift)
     return norm
+
+
+def _separatrix_drift(D, m0, m1, m2, n0, n1, n2, d0, d1, d2, rtol):
+    """One free step's estimated change of ``Δ = m·D m``, ``2 (D m_new)·δm``, against
+    ``SEPARATRIX_SHARE · rtol |Δ|`` or ``Δ``'s rounding (:func:`error_norm`)."""
+    k0, k1, k2 = _apply(D, n0, n1, n2)
+    change = 2.0 * (k0 * d0 + k1 * d1 + k2 * d2)
+    if change == 0.0:
+        return 0.0
+    s0, s1, s2 = _apply(D, m0, m1, m2)
+    delta = max(abs(m0 * s0 + m1 * s1 + m2 * s2), abs(n0 * k0 + n1 * k1 + n2 * k2))
+    rounding = math.sqrt((n0 * n0 + n1 * n1 + n2 * n2) * (k0 * k0 + k1 * k1 + k2 * k2))
+    return abs(change) / (SEPARATRIX_SHARE * rtol * delta + ROUNDING * rounding)
+
+
+def _mixed(e, atol, rtol, old, new):
+    """``(e / (atol + rtol max(|old|, |new|)))²``, zero for an error of exactly zero."""
+    if e == 0.0:
+        return 0.0
+    return (e / (atol + rtol * max(abs(old), abs(new)))) ** 2
+
+
+def _largest(norm, part):
+    """``max(norm, part)``, NaN if either is (a NaN part rejects the step)."""
+    if part != part or norm != norm:
+        return math.nan
+    return max(norm, part)
+
+
+def _exp_coefficients(theta2):
+    """``(sin θ/θ, (1 − cos θ)/θ², (1 − sin θ/θ)/θ²)`` for ``θ² = theta2``: ``exp(û)`` and
+    ``dexp_u`` by cross products. The norm only weighs errors, so the plain forms do (each
+    coefficient's rounding, times θ², stays within an ulp of the vector it turns)."""
+    if theta2 == 0.0:
+        return 1.0, 0.5, 1.0 / 6.0
+    theta = math.sqrt(theta2)
+    a = math.sin(theta) / theta
+    half = math.sin(0.5 * theta) / theta
+    return a, 2.0 * half * half, (1.0 - a) / theta2
+
+
+def _apply(M, v0, v1, v2):
+    """``M v`` for a 3×3 ``M``."""
+    return (
+        M[0, 0] * v0 + M[0, 1] * v1 + M[0, 2] * v2,
+        M[1, 0] * v0 + M[1, 1] * v1 + M[1, 2] * v2,
+        M[2, 0] * v0 + M[2, 1] * v1 + M[2, 2] * v2,
+    )
+
+
+def _transpose_apply(M, v0, v1, v2):
+    """``Mᵀ v`` for a 3×3 ``M``."""
+    return (
+        M[0, 0] * v0 + M[1, 0] * v1 + M[2, 0] * v2,
+        M[0, 1] * v0 + M[1, 1] * v1 + M[2, 1] * v2,
+        M[0, 2] * v0 + M[1, 2] * v1 + M[2, 2] * v2,
+    )
+
+
+def _rotate(a, b, u0, u1, u2, v0, v1, v2):
+    """``v + a u×v + b u×(u×v)``: ``exp(−û) v`` for ``(−sin θ/θ, (1 − cos θ)/θ²)``,
+    ``dexp_{−u} v`` for ``(−(1 − cos θ)/θ², (1 − sin θ/θ)/θ²)``."""
+    c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
+    d0, d1, d2 = u1 * c2 - u2 * c1, u2 * c0 - u0 * c2, u0 * c1 - u1 * c0
+    return v0 + a * c0 + b * d0, v1 + a * c1 + b * d1, v2 + a * c2 + b * d2
+
+
+NORM_HELPERS = (
+    "_separatrix_drift", "_mixed", "_largest", "_exp_coefficients", "_apply",
+    "_transpose_apply", "_rotate",
+)  # fmt: skip
+"""The functions :func:`error_norm` calls, compiled beside it by :mod:`tumble.rigid.kernels`."""
 
 
 def _lie_first_same_as_last(K: np.ndarray, z_new: np.ndarray) -> np.ndarray:

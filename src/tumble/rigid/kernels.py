@@ -414,13 +414,14 @@ def _batch(problem, grid, Z, RN, every, records, counts, failed, causes):
                                                body_records)  # fmt: skip
 
 
-def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, fsal, z, Rn, every, step0,
-                   max_steps, records):  # fmt: skip
+def _adaptive_loop(problem, e, t, t1, h, rtol, atol, separatrix, control, fsal, z, Rn, every,
+                   step0, max_steps, records):  # fmt: skip
     """Adaptive steps from ``t`` towards ``t1`` for one chart: the driver's adaptive loop,
     compiled (:func:`tumble.ode.driver.march` with a ``Control``).
 
     Each try is the step of :func:`_loop` plus the embedded error estimate
-    ``h Σ e_i k_i``; its norm is :func:`tumble.rigid.charts.error_norm` and the next step
+    ``h Σ e_i k_i``; its norm is :func:`tumble.rigid.charts.error_norm` (``separatrix``: its
+    :func:`~tumble.rigid.charts.separatrix_form`) and the next step
     comes from :func:`tumble.ode.control.step_factor` (both compiled from those very
     functions), tries start from the accepted state, and a step below
     :func:`tumble.ode.control.minimum_step` ends the run, as in the driver. ``control`` is
@@ -437,7 +438,6 @@ def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, fsal, z, Rn, every
     A, b = problem.A, problem.b
     safety, min_factor, max_factor, order, horizon = control
     s, nz = b.shape[0], z.shape[0]
-    size = nz - 9
     K, zs, err, R = np.empty((s, nz)), np.empty(nz), np.empty(nz), np.empty((3, 3))
     capacity = records.t.shape[0]
     count, until_record = 0, every - step0 % every
@@ -456,9 +456,8 @@ def _adaptive_loop(problem, e, t, t1, h, rtol, atol, control, fsal, z, Rn, every
                 acc_e += e[i] * K[i, q]
             zs[q] = z[q] + hk * acc
             err[q] = hk * acc_e
-        norm = NORM(err, size, z[size:], zs[size:], rtol, atol)  # noqa: F821
-        if horizon > 0.0:  # error per unit step (Control.horizon)
-            norm *= horizon / hk
+        share = hk / horizon if horizon > 0.0 else 1.0  # error per unit step (Control.horizon)
+        norm = NORM(err, z, zs, Rn, rtol, atol, separatrix, share) / share  # noqa: F821
         h = hk * FACTOR(norm, order, safety, min_factor, max_factor, after_rejection)  # noqa: F821
         after_rejection = not norm <= 1.0
         if after_rejection:
@@ -510,17 +509,32 @@ class CompiledChart:
 # functions, compiled here: the adaptive loop and the driver cannot drift apart.
 _STEP_FACTOR = njit(**_INLINE)(control.step_factor)
 _MINIMUM_STEP = njit(**_INLINE)(control.minimum_step)
-_ERROR_NORM = njit(**_INLINE)(charts.error_norm)
+
+
+def _compiled_norm():
+    """:func:`tumble.rigid.charts.error_norm` and its helpers compiled, each calling the
+    others' compiled twins (one namespace for all)."""
+    namespace = dict(vars(charts))
+    for name in (*charts.NORM_HELPERS, "error_norm"):
+        code = getattr(charts, name).__code__
+        namespace[name] = njit(**_INLINE)(types.FunctionType(code, namespace, name))
+    return namespace["error_norm"]
+
+
+_ERROR_NORM = _compiled_norm()
 
 
 def _for_chart(
-    name: str, field, advance, record, start=_no_start, fsal=_no_first_same_as_last
-) -> CompiledChart:
+    name: str, field, advance, record, start=_no_start, fsal=_no_first_same_as_last,
+    adaptive: bool = False,
+) -> CompiledChart:  # fmt: skip
     stages = njit(**_INLINE)(_bind(_stages, f"_stages_{name}", FIELD=field))
     chart = dict(STAGES=stages, ADVANCE=advance, RECORD=record, START=start)
     loop = njit(**_JIT)(_bind(_loop, f"_loop_{name}", **chart))
     batch = njit(parallel=True, **_JIT)(_bind(_batch, f"_batch_{name}", LOOP=loop))
-    adaptive = njit(**_JIT)(
+    if not adaptive:  # the error norm is the lie chart's (every adaptive method is one)
+        return CompiledChart(loop, batch)
+    adaptive_loop = njit(**_JIT)(
         _bind(
             _adaptive_loop,
             f"_adaptive_{name}",
@@ -531,14 +545,14 @@ def _for_chart(
             **chart,
         )
     )
-    return CompiledChart(loop, batch, adaptive)
+    return CompiledChart(loop, batch, adaptive_loop)
 
 
 COMPILED: dict[str, CompiledChart] = {
     "matrix": _for_chart("matrix", _matrix_field, _matrix_advance, _matrix_record),
     "quat": _for_chart("quat", _quat_field, _quat_advance, _quat_record, _quat_start),
     "lie": _for_chart(
-        "lie", _lie_field, _lie_advance, _lie_record, fsal=_lie_first_same_as_last
+        "lie", _lie_field, _lie_advance, _lie_record, fsal=_lie_first_same_as_last, adaptive=True
     ),  # fmt: skip
 }
 """Each chart of :data:`tumble.rigid.charts.CHARTS`, compiled."""

@@ -27,7 +27,7 @@ from tumble.ode.dense import StepInterpolant, step_coefficients
 from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Stepper, non_finite_message
 from tumble.ode.stepper import rk_step
 from tumble.rigid import geometric
-from tumble.rigid.charts import CHARTS, Dynamics, error_norm
+from tumble.rigid.charts import CHARTS, LIE, Dynamics, error_norm, separatrix_form
 from tumble.rigid.forces import State
 from tumble.rigid.methods import Method
 
@@ -92,9 +92,12 @@ class RigidStepper(BodyStepper):
         self.adaptive = method.adaptive
         self.error_order = method.tableau.error_order
         self._quat = self.chart.name == "quat"
-        self._last: tuple = ()  # the last step's field, z, base point, stages and z_new
+        self._last: tuple = ()  # the last step's field, z, base point, stages, z_new and h
         self._fsal = method.tableau.fsal and self.chart.first_same_as_last is not None
         self._first: tuple = (None, None)  # (accepted state, its first stage) with FSAL
+        if self.adaptive and self.chart is not LIE:
+            raise NotImplementedError(f"{method.name!r}: the error norm is the lie chart's")
+        self.separatrix = separatrix_form(dynamics.body.inertia) if self.adaptive else None
 
     def start(self, state: tuple[np.ndarray, np.ndarray]) -> RigidState:
         """The stepped state for ``(R, Y)``: the attitude matrix and ``Y = (x, p, L)``."""
@@ -112,21 +115,26 @@ class RigidStepper(BodyStepper):
         K = np.empty((tableau.stages, z.size))
         first = self._first[1] if self._first[0] is state else f(t, z)
         z_new, error = rk_step(f, t, z, first, h, tableau, K)
-        self._last = (f, z, Rn, K, z_new)
+        self._last = (f, z, Rn, K, z_new, h)
         return chart.advance(z_new, Rn), error
 
     def accept(self, t: float, state: RigidState) -> None:
         """With a FSAL tableau keep the accepted step's last stage as the next one's first
         (:attr:`~tumble.rigid.charts.Chart.first_same_as_last`): one evaluation saved."""
         if self._fsal:
-            _, _, _, K, z_new = self._last
+            _, _, _, K, z_new, _ = self._last
             assert self.chart.first_same_as_last is not None
             self._first = (state, self.chart.first_same_as_last(K, z_new))
 
     def norm(self, error: np.ndarray, old: RigidState, new: RigidState, control: Control) -> float:
-        """:func:`~tumble.rigid.charts.error_norm`: the attitude against rtol (radians in
-        the ``lie`` chart), x, p and L against ``atol + rtol |y|``."""
-        return error_norm(error, self.chart.size, old[1], new[1], control.rtol, control.atol)
+        """:func:`~tumble.rigid.charts.error_norm` of the last step: the attitude in radians
+        against rtol, x and p against ``atol + rtol |y|``, the body momentum ``Rᵀ L``
+        component by component against ``atol + rtol |m|``, and without torque the drift of
+        the distance to the separatrix against rtol."""
+        _, z, Rn, _, z_new, h = self._last
+        share = h / control.horizon if control.horizon else 1.0
+        atol = np.broadcast_to(np.asarray(control.atol, dtype=float), (9,))
+        return error_norm(error, z, z_new, Rn, control.rtol, atol, self.separatrix, share)
 
     def interpolant(
         self, t_old: float, old: RigidState, t_new: float, new: RigidState
@@ -137,7 +145,7 @@ class RigidStepper(BodyStepper):
         cubic Hermite otherwise), so every sample is a rotation to round-off; ``x``, ``p``,
         ``L`` are interpolated the same way. Costs one field evaluation a step without a FSAL
         tableau (``f`` at the step's end, in the step's chart)."""
-        f, z, Rn, K, z_new = self._last
+        f, z, Rn, K, z_new, _ = self._last
         tableau, chart, h = self.method.tableau, self.chart, t_new - t_old
         assert tableau is not None
         f1 = K[-1] if tableau.fsal else f(t_new, z_new)
@@ -236,8 +244,8 @@ class CompiledStepper(RigidStepper):
         atol = np.broadcast_to(np.asarray(control.atol, dtype=float), (9,)).copy()
         announce_compilation(self.adaptive_loop, f"the {self.chart.name} chart's adaptive loop")
         count, t_end, h_next, accepted, rejected, code, t_failed, finite = self.adaptive_loop(
-            self.problem, tableau.e, t, t1, h, control.rtol, atol, settings, self._fsal, z, Rn,
-            every, step0, float(max_steps), records,
+            self.problem, tableau.e, t, t1, h, control.rtol, atol, self.separatrix, settings,
+            self._fsal, z, Rn, every, step0, float(max_steps), records,
         )  # fmt: skip
         q = records.q[:count] if self._quat else np.empty((count, 0))
         return AdaptiveBlock(
