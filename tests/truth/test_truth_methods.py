@@ -225,6 +225,20 @@ def rtols() -> st.SearchStrategy:
     return st.floats(-10.0, -5.0).map(lambda e: 10.0**e)
 
 
+def adaptive_run(method: str, problem: Problem, t_end: float, rtol: float) -> tuple:
+    """An adaptive run of ``problem`` to ``t_end`` at ``rtol`` (asserted to succeed), the
+    reference R(T), the run's error against it, and its round-off floor: ``FLOOR_ULPS`` ulps
+    a step amplified by the problem's measured sensitivity, plus the reference's error."""
+    R_ref, ref_error, sensitivity = reference(problem, t_end)
+    run = simulate(problem.body, t_end, method=method, rtol=rtol, omega0=problem.omega0,
+                   R0=np.array(problem.R0), forces=problem.forces,
+                   pivot=problem.loads.pivot)  # fmt: skip
+    assert run.status == 0, run.message
+    error = float(np.linalg.norm(run.R[-1] - R_ref))
+    floor = FLOOR_ULPS * run.n_steps * ULP * (3.0 + sensitivity) + ref_error
+    return run, R_ref, error, floor, sensitivity
+
+
 @pytest.mark.parametrize("method", ADAPTIVE)
 @sample(default=4, nightly=80)
 @given(problem=problems(), turns=st.floats(1.0, 30.0), rtol=rtols())
@@ -233,13 +247,7 @@ def test_adaptive_error_stays_within_rtol_amplified_by_the_problem(method, probl
     errors sum to ``rtol``, and the problem amplifies a relative error of the state by at
     most its measured sensitivity: ``e ≤ ADAPTIVE_SLACK · rtol · (1 + sensitivity)``."""
     t_end = turns * problem.time_scale
-    R_ref, ref_error, sensitivity = reference(problem, t_end)
-    run = simulate(problem.body, t_end, method=method, rtol=rtol, omega0=problem.omega0,
-                   R0=np.array(problem.R0), forces=problem.forces,
-                   pivot=problem.loads.pivot)  # fmt: skip
-    assert run.status == 0, run.message
-    error = float(np.linalg.norm(run.R[-1] - R_ref))
-    floor = FLOOR_ULPS * run.n_steps * ULP * (3.0 + sensitivity) + ref_error
+    run, _, error, floor, sensitivity = adaptive_run(method, problem, t_end, rtol)
     bound = ADAPTIVE_SLACK * rtol * (1.0 + sensitivity) + floor
     assert error <= bound, (
         f"{method} at rtol {rtol:.1e}: error {error:.2e} > {bound:.2e} "
@@ -256,16 +264,10 @@ def test_adaptive_error_is_within_ten_times_scipys_rk45(method, problem, turns, 
     """Issue 24 part 3's goal, on every problem: within 10× of scipy's RK45 on Euler's
     equations with a quaternion (``atol = rtol·1e-3``, as docs/rigid-body.md's table)."""
     t_end = turns * problem.time_scale
-    R_ref, ref_error, sensitivity = reference(problem, t_end)
-    run = simulate(problem.body, t_end, method=method, rtol=rtol, omega0=problem.omega0,
-                   R0=np.array(problem.R0), forces=problem.forces,
-                   pivot=problem.loads.pivot)  # fmt: skip
-    assert run.status == 0, run.message
+    run, R_ref, error, floor, _ = adaptive_run(method, problem, t_end, rtol)
     R_scipy = forced_rotation(problem.moments, np.array(problem.omega0), np.array(problem.R0),
                               problem.loads, t_end, rtol=rtol, method="RK45")  # fmt: skip
-    error = float(np.linalg.norm(run.R[-1] - R_ref))
     peer = float(np.linalg.norm(R_scipy - R_ref))
-    floor = FLOOR_ULPS * run.n_steps * ULP * (3.0 + sensitivity) + ref_error
     assert error <= 10.0 * peer + floor, (
         f"{method} at rtol {rtol:.1e}: error {error:.2e}, {error / peer:.3g}× scipy RK45's "
         f"{peer:.2e}; T = {t_end:.4g} s; {problem}"

@@ -136,12 +136,11 @@ def _lie_field(dynamics: Dynamics, correct: bool, Rn: np.ndarray) -> Field:
 SEPARATRIX_SHARE = 0.1
 """The share of ``rtol |Δ|`` by which one step may (by its error estimate) change the distance
 to the separatrix ``Δ`` (:func:`error_norm`). Per step, not per unit time as the other
-parts: the embedded estimate of a change of ``Δ`` overstates the accepted solution's by
-about ``1/(h λ)`` (orders 4 and 5 against 5 and 6; measured 20–400× near the flip), so held
-per unit time it would cost the T-handle's flipping spin 2.7× the steps for no gain. A tenth,
-per step, keeps flip times and attitudes near the separatrix within about 10× of scipy RK45 at
-equal rtol from 1e-3 to 1e-6 off the middle axis, at +19–47 % steps on the T-handle
-(docs/rigid-body.md)."""
+parts: the embedded estimate of a change of ``Δ`` overstates the accepted solution's, so held
+per unit time it would cost many more steps for no gain. A tenth is chosen from
+measurements, not derived: with it the issue's spin (diag(3, 2, 1.5), ω0 = (1e-6, 1, 1e-6),
+rtol 1e-8) stays within 10× of scipy RK45's attitude error
+(``tests/truth/test_truth_methods.py``)."""
 
 ROUNDING = 2.220446049250313e-16
 """One ulp at 1 (``np.finfo(float).eps``): ``Δ = m·D m`` is not known better than
@@ -276,8 +275,9 @@ def _transpose_apply(M, v0, v1, v2):
 
 
 def _rotate(a, b, u0, u1, u2, v0, v1, v2):
-    """``v + a u×v + b u×(u×v)``: ``exp(−û) v`` for ``(−sin θ/θ, (1 − cos θ)/θ²)``,
-    ``dexp_{−u} v`` for ``(−(1 − cos θ)/θ², (1 − sin θ/θ)/θ²)``."""
+    """``v + a u×v + b u×(u×v)``: ``exp(±û) v`` for ``(±sin θ/θ, (1 − cos θ)/θ²)``,
+    ``dexp_{−u} v`` for ``(−(1 − cos θ)/θ², (1 − sin θ/θ)/θ²)``, ``dexp⁻¹_{−u} v`` for
+    ``(½, α)`` (:mod:`tumble.rigid.kernels` compiles this one for its loops too)."""
     c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
     d0, d1, d2 = u1 * c2 - u2 * c1, u2 * c0 - u0 * c2, u0 * c1 - u1 * c0
     return v0 + a * c0 + b * d0, v1 + a * c1 + b * d1, v2 + a * c2 + b * d2

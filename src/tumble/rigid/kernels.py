@@ -91,33 +91,11 @@ def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@njit(**_JIT)
-def _rotate(a, b, u0, u1, u2, v0, v1, v2):
-    """``v + a u×v + b u×(u×v)``: ``exp(û) v`` for exp's ``(a, b)``, ``exp(−û) v`` for
-    ``(−a, b)``, ``dexp⁻¹_{−u} v`` for ``(½, α)``."""
-    c0, c1, c2 = _cross(u0, u1, u2, v0, v1, v2)
-    d0, d1, d2 = _cross(u0, u1, u2, c0, c1, c2)
-    return v0 + a * c0 + b * d0, v1 + a * c1 + b * d1, v2 + a * c2 + b * d2
-
-
-@njit(**_JIT)
-def _apply(M, v0, v1, v2):
-    """``M v`` for a 3×3 ``M``."""
-    return (
-        M[0, 0] * v0 + M[0, 1] * v1 + M[0, 2] * v2,
-        M[1, 0] * v0 + M[1, 1] * v1 + M[1, 2] * v2,
-        M[2, 0] * v0 + M[2, 1] * v1 + M[2, 2] * v2,
-    )
-
-
-@njit(**_JIT)
-def _apply_transpose(M, v0, v1, v2):
-    """``Mᵀ v`` for a 3×3 ``M``."""
-    return (
-        M[0, 0] * v0 + M[1, 0] * v1 + M[2, 0] * v2,
-        M[0, 1] * v0 + M[1, 1] * v1 + M[2, 1] * v2,
-        M[0, 2] * v0 + M[1, 2] * v1 + M[2, 2] * v2,
-    )
+# The 3 × 3 helpers are the Python reference's own (tumble.rigid.charts: its error norm
+# uses them), compiled: one definition for both paths.
+_rotate = njit(**_JIT)(charts._rotate)
+_apply = njit(**_JIT)(charts._apply)
+_apply_transpose = njit(**_JIT)(charts._transpose_apply)
 
 
 @njit(**_JIT)
@@ -865,7 +843,7 @@ def _complete_part(nu, m, m_1):
 
 
 @njit(**_JIT)
-def _elliptic_step(wb, other_w, pole_w, amplitudes, pole, rate, m, m_1, nu, h, work):
+def _elliptic_step(wb, other_w, pole_w, amplitudes, rate, m, m_1, nu, h, work):
     """The elliptic motion from ω over ``h``: ``(ω_other, ω_B, ω_pole)`` at ``h`` and the
     difference over the step of the precession integral's part P (``Π(−ν; am u) = F + P``
     for ``ν < 1``, ``= P`` from 1 up; ``tumble._elliptic``'s ``elliptic_motion``,
@@ -1014,11 +992,11 @@ def _exact_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
         e0, e1, e2, integral = _separatrix_step(wa, wb, wc, amp_a, amp_b, amp_c, rate, nu, h)
     elif pole == 2:
         e0, e1, e2, integral = _elliptic_step(
-            wb, wa, wc, (amp_a, amp_b, amp_c), pole, rate, m, m_1, nu, h, work
+            wb, wa, wc, (amp_a, amp_b, amp_c), rate, m, m_1, nu, h, work
         )
     else:
         e2, e1, e0, integral = _elliptic_step(
-            wb, wc, wa, (amp_c, amp_b, amp_a), pole, rate, m, m_1, nu, h, work
+            wb, wc, wa, (amp_c, amp_b, amp_a), rate, m, m_1, nu, h, work
         )
     norm = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
     scale = weight * norm * (C - A) / (A * C * rate)

@@ -18,7 +18,7 @@ from numpy.typing import NDArray
 from tumble.structural.kernels import (
     assemble_internal_forces_pair,
     banded_solve,
-    energy_exceeds,
+    watch_step,
 )
 
 
@@ -53,8 +53,7 @@ def run_alpha_steps(
     n = x.size
     diverged, energy = -1, -1.0
     damped = indptr.size > 0
-    every, final, no_lag = watch[0], watch[1], x[:0]
-    until_check = every - first % every
+    no_lag, until_check = x[:0], watch[0] - first % watch[0]
     for k in range(first + 1, last + 1):
         for i in range(n):
             rhs[i] = dt * (c_r * r[i] + (1.0 - c_r) * m[i] - p[i])
@@ -79,14 +78,8 @@ def run_alpha_steps(
                     r_new -= data[j] * y[indices[j]]
             m[i] = m_new * r_new + m_old * r[i] - m_prev * m[i]
             r[i] = r_new
-        until_check -= 1
-        grown = False
-        if (until_check == 0 or k == final) and not non_finite:
-            grown, value = energy_exceeds(k * dt, x, y, q, no_lag, watch)
-            if grown:
-                energy = value
-        if until_check == 0:
-            until_check = every
+        grown, energy, until_check = watch_step(k, until_check, non_finite, k * dt, x, y, q,
+                                                no_lag, watch)  # fmt: skip
         if non_finite or k == record_steps[row]:
             xs[row] = x
             ys[row] = y
@@ -129,8 +122,7 @@ def run_bathe_steps(
     n = x.size
     diverged, energy = -1, -1.0
     damped = indptr.size > 0
-    every, final, no_lag = watch[0], watch[1], x[:0]
-    until_check = every - first % every
+    no_lag, until_check = x[:0], watch[0] - first % watch[0]
     for k in range(first + 1, last + 1):
         for i in range(n):  # trapezoidal sub-step over τ; r = q − C y
             r_old[i] = q[i]
@@ -167,14 +159,8 @@ def run_bathe_steps(
         assemble_internal_forces_pair(dxs, y, *frame, sdx, g)  # type: ignore[call-arg]
         for i in range(n):
             q[i] -= sdx[i]
-        until_check -= 1
-        grown = False
-        if (until_check == 0 or k == final) and not non_finite:
-            grown, value = energy_exceeds(k * dt, x, y, q, no_lag, watch)
-            if grown:
-                energy = value
-        if until_check == 0:
-            until_check = every
+        grown, energy, until_check = watch_step(k, until_check, non_finite, k * dt, x, y, q,
+                                                no_lag, watch)  # fmt: skip
         if non_finite or k == record_steps[row]:
             xs[row] = x
             ys[row] = y

@@ -67,7 +67,6 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from fractions import Fraction
 
 import numpy as np
 import scipy.sparse as sp
@@ -146,7 +145,7 @@ class EnergyWatch:
     every: int = CHECK_EVERY
     final: int = -1
     energy: float = math.nan
-    _band: NDArray[np.float64] | None = field(default=None, repr=False)
+    _arrays: tuple | None = field(default=None, repr=False)
 
     @classmethod
     def start(
@@ -185,13 +184,21 @@ class EnergyWatch:
     def kernel(self, order: NDArray[np.intp]) -> tuple:
         """``(every, final, √V₀, P, GROWTH_LIMIT, mass, f, c)`` as the compiled loops read
         it: ``mass`` is :func:`lower_band` of ``M``, ``f`` the loads, in the DOF ``order``,
-        and ``c`` :func:`diagonal_bound`."""
-        if self._band is None:
-            self._band = lower_band(self.system.M, order)
+        and ``c`` :func:`diagonal_bound` (the three made at the first call: a run asks again
+        at every block, with only ``P`` changed by :meth:`confirms`)."""
+        if self._arrays is None:
+            M, f = self.system.M, self.system.f
+            self._arrays = (lower_band(M, order), np.ascontiguousarray(f[order]),
+                            diagonal_bound(M))  # fmt: skip
         final = self.final if self.final >= self.every else -1
-        return (self.every, final, math.sqrt(self.initial), self.power, GROWTH_LIMIT,
-                self._band, np.ascontiguousarray(self.system.f[order]),
-                diagonal_bound(self.system.M))  # fmt: skip
+        return (
+            self.every,
+            final,
+            math.sqrt(self.initial),
+            self.power,
+            GROWTH_LIMIT,
+            *self._arrays,
+        )
 
     def message(self, t_old: float, t_new: float) -> str:
         """What a run whose check failed at ``t_new`` says (before its likely cause); it
@@ -245,17 +252,6 @@ def likely_cause(system: LinearSystem, scheme, dt: float) -> str:
 
 
 def describe(scheme) -> str:
-    """A scheme by its name and parameters: ``Newmark β=1/6, γ=1/2``."""
-    from tumble.structural.schemes import Newmark
-
-    if isinstance(scheme, Newmark):
-        return f"Newmark β={_number(scheme.beta)}, γ={_number(scheme.gamma)}"
-    return f"the {scheme.name} scheme"
-
-
-def _number(value: float) -> str:
-    """``1/6`` for a simple fraction, else 4 digits."""
-    fraction = Fraction(value).limit_denominator(64)
-    if abs(float(fraction) - value) <= 1e-12 * abs(value):
-        return str(fraction)
-    return f"{value:.4g}"
+    """A scheme by its ``label`` when it has one (its parameters: ``Newmark β=1/6, γ=1/2``),
+    else by its name."""
+    return getattr(scheme, "label", None) or f"the {scheme.name} scheme"

@@ -166,6 +166,26 @@ def energy_exceeds(
     return not energy <= limit, energy
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def watch_step(
+    k: int, until_check: int, non_finite: int, t: float, x: NDArray[np.float64],
+    y: NDArray[np.float64], q: NDArray[np.float64], lag: NDArray[np.float64], watch: tuple,
+) -> tuple[bool, float, int]:  # fmt: skip
+    """The energy check's cadence in every structural loop, after step ``k`` at ``t``: count
+    down ``until_check`` and, at zero or at the run's last step ``watch[1]``, ask
+    :func:`energy_exceeds` (not after a non-finite step, which stops the loop anyway).
+    Returns whether the run has diverged, ``V`` if so (else -1.0), and the next countdown."""
+    until_check -= 1
+    grown, energy = False, -1.0
+    if (until_check == 0 or k == watch[1]) and not non_finite:
+        grown, value = energy_exceeds(t, x, y, q, lag, watch)
+        if grown:
+            energy = value
+    if until_check == 0:
+        until_check = watch[0]
+    return grown, energy, until_check
+
+
 @numba.njit(cache=True, nogil=True, fastmath={"contract"})
 def banded_solve(
     forward: NDArray[np.float64],
@@ -275,8 +295,7 @@ def run_steps(
     n = x.size
     h[:] = 0.0
     diverged, energy = -1, -1.0
-    every, final = watch[0], watch[1]
-    until_check = every - first % every
+    until_check = watch[0] - first % watch[0]
     for k in range(first + 1, last + 1):
         for i in range(n):  # r = q − C y, q = f − S x first taking the last step's S Δx
             q[i] -= h[i]
@@ -310,14 +329,8 @@ def run_steps(
             assemble_internal_forces_pair(rhs, y, *frame, h, g)  # type: ignore[call-arg]
         else:
             assemble_internal_forces(rhs, *frame, h)  # type: ignore[call-arg]
-        until_check -= 1
-        grown = False
-        if (until_check == 0 or k == final) and not non_finite:
-            grown, value = energy_exceeds(k * dt, x, y, q, h, watch)
-            if grown:
-                energy = value
-        if until_check == 0:
-            until_check = every
+        grown, energy, until_check = watch_step(k, until_check, non_finite, k * dt, x, y, q, h,
+                                                watch)  # fmt: skip
         if non_finite or k == record_steps[row]:
             xs[row] = x
             ys[row] = y

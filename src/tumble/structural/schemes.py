@@ -60,6 +60,7 @@ from __future__ import annotations
 import contextlib
 import math
 from dataclasses import dataclass, field
+from fractions import Fraction
 
 import numpy as np
 import scipy.sparse as sp
@@ -152,6 +153,11 @@ class Newmark:
     def order(self) -> int:
         """Order of accuracy: 2 for γ = ½, else 1 (Hughes 2000, §9.1)."""
         return 2 if self.gamma == 0.5 else 1
+
+    @property
+    def label(self) -> str:
+        """The scheme with its parameters, as messages name it: ``Newmark β=1/6, γ=1/2``."""
+        return f"Newmark β={_fraction(self.beta)}, γ={_fraction(self.gamma)}"
 
     def matrix(self, system: LinearSystem, C: sp.spmatrix | None, dt: float) -> sp.spmatrix:
         """The constant matrix ``M + γ Δt C + β Δt² S``."""
@@ -442,3 +448,11 @@ def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | N
 def _quiet_overflow() -> contextlib.AbstractContextManager:
     """Diverging schemes overflow by design; the driver reports it as a status."""
     return np.errstate(over="ignore", invalid="ignore")
+
+
+def _fraction(value: float) -> str:
+    """``1/6`` for a simple fraction, else 4 digits."""
+    fraction = Fraction(value).limit_denominator(64)
+    if abs(float(fraction) - value) <= 1e-12 * abs(value):
+        return str(fraction)
+    return f"{value:.4g}"
