@@ -57,7 +57,8 @@ def check_steps(method: Method, h, rtol, atol) -> tuple[float | None, float, np.
         raise _checks.fail(
             "atol", atol, ">= 0 and finite: a scalar, or shape (9,) for (x, p, L)",
             "m, kg m/s, kg m²/s",
-            remedy="atol applies to x, p and L; the attitude is measured against rtol alone",
+            remedy="atol applies to x, p and L (L's components in the body frame); the "
+            "attitude is measured against rtol alone",
         )  # fmt: skip
     return h, rtol, np.broadcast_to(checked, (9,)).copy()
 
@@ -76,7 +77,8 @@ def adaptive_names() -> str:
 def sizes(body: RigidBody, Y: np.ndarray, span: float) -> np.ndarray:
     """Characteristic sizes of ``(x, p, L)``, shape (9,): each part's initial size, and at
     least one radius of gyration ``ℓ = √(tr I / m)`` for x, ``m ℓ / T`` for p and ``m ℓ² / T``
-    for L (a gyration radius, or a radian, over the run's length ``T``)."""
+    for L (a gyration radius, or a radian, over the run's length ``T``). ``|L|`` is the same
+    in the world and the body frame, where the error norm measures L's components."""
     m = body.mass
     ell = float(np.sqrt(np.trace(body.inertia) / m))
     floors = (ell, m * ell / span, m * ell * ell / span)
