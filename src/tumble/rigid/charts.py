@@ -137,11 +137,12 @@ SEPARATRIX_SHARE = 0.1
 """The share of ``rtol |Δ|`` by which one step may (by its error estimate) change the distance
 to the separatrix ``Δ`` (:func:`error_norm`). Per step, not per unit time as the other
 parts: the embedded estimate of a change of ``Δ`` overstates the accepted solution's by
-about ``1/(h λ)`` (orders 4 and 5 against 5 and 6; measured 20–400× near the flip), so held
-per unit time it would cost the T-handle's flipping spin 2.7× the steps for no gain. A tenth,
-per step, keeps flip times and attitudes near the separatrix within about 10× of scipy RK45 at
-equal rtol from 1e-3 to 1e-6 off the middle axis, at +19–47 % steps on the T-handle
-(docs/rigid-body.md)."""
+about ``1/(h λ)`` (it falls as h⁵, the accepted change of Δ as h⁶; measured 20–400× near a
+flip), so held per unit time it would cost the T-handle's flipping spin 2.7× the steps for
+no gain. A tenth, per step, keeps attitudes and flip times near the separatrix within 10× of
+scipy RK45 at equal rtol, or of the problem's round-off floor, from 1e-3 to 1e-8 off the
+middle axis (all but ``rkmk45``'s flips at 1e-3, rtol 1e-8: 15×), at 1.2–1.9× the steps on
+the T-handle's flipping spin (docs/rigid-body.md)."""
 
 ROUNDING = 2.220446049250313e-16
 """One ulp at 1 (``np.finfo(float).eps``): ``Δ = m·D m`` is not known better than
