@@ -136,11 +136,13 @@ def _lie_field(dynamics: Dynamics, correct: bool, Rn: np.ndarray) -> Field:
 SEPARATRIX_SHARE = 0.1
 """The share of ``rtol |Δ|`` by which one step may (by its error estimate) change the distance
 to the separatrix ``Δ`` (:func:`error_norm`). Per step, not per unit time as the other
-parts: the embedded estimate of a change of ``Δ`` overstates the accepted solution's, so held
-per unit time it would cost many more steps for no gain. A tenth is chosen from
-measurements, not derived: with it the issue's spin (diag(3, 2, 1.5), ω0 = (1e-6, 1, 1e-6),
-rtol 1e-8) stays within 10× of scipy RK45's attitude error
-(``tests/truth/test_truth_methods.py``)."""
+parts: the embedded estimate of a change of ``Δ`` overstates the accepted solution's by
+about ``1/(h λ)`` (it falls as h⁵, the accepted change of Δ as h⁶; measured 20–400× near a
+flip), so held per unit time it would cost the T-handle's flipping spin 2.7× the steps for
+no gain. A tenth, per step, keeps attitudes and flip times near the separatrix within 10× of
+scipy RK45 at equal rtol, or of the problem's round-off floor, from 1e-3 to 1e-8 off the
+middle axis (all but ``rkmk45``'s flips at 1e-3, rtol 1e-8: 15×), at 1.2–1.9× the steps on
+the T-handle's flipping spin (docs/rigid-body.md)."""
 
 ROUNDING = 2.220446049250313e-16
 """One ulp at 1 (``np.finfo(float).eps``): ``Δ = m·D m`` is not known better than
@@ -246,14 +248,19 @@ def _largest(norm, part):
 
 def _exp_coefficients(theta2):
     """``(sin θ/θ, (1 − cos θ)/θ², (1 − sin θ/θ)/θ²)`` for ``θ² = theta2``: ``exp(û)`` and
-    ``dexp_u`` by cross products. The norm only weighs errors, so the plain forms do (each
-    coefficient's rounding, times θ², stays within an ulp of the vector it turns)."""
-    if theta2 == 0.0:
-        return 1.0, 0.5, 1.0 / 6.0
-    theta = math.sqrt(theta2)
+    ``dexp_u`` by cross products. Below 0.25 rad (a step's usual turn) their Taylor series to
+    θ⁸, whose first term left out is below 3e-14 relative: the norm only weighs errors, and
+    each coefficient's error times θ² stays within an ulp of the vector it turns."""
+    x = theta2
+    if x < 0.0625:
+        a = 1.0 + x * (-1.0 / 6 + x * (1.0 / 120 + x * (-1.0 / 5040 + x / 362880)))
+        b = 0.5 + x * (-1.0 / 24 + x * (1.0 / 720 + x * (-1.0 / 40320 + x / 3628800)))
+        c = 1.0 / 6 + x * (-1.0 / 120 + x * (1.0 / 5040 + x * (-1.0 / 362880 + x / 39916800)))
+        return a, b, c
+    theta = math.sqrt(x)
     a = math.sin(theta) / theta
     half = math.sin(0.5 * theta) / theta
-    return a, 2.0 * half * half, (1.0 - a) / theta2
+    return a, 2.0 * half * half, (1.0 - a) / x
 
 
 def _apply(M, v0, v1, v2):
