@@ -84,7 +84,7 @@ body = RigidBody(1.0, np.diag([1.0, 2.0, 3.0]))
 marks = [time.thread_time()]
 import numba
 marks.append(time.thread_time())
-import tumble.rigid.kernels
+import tumble.rigid._compiled.flows
 marks.append(time.thread_time())
 from numba.core.registry import cpu_target
 cpu_target.target_context.refresh()
@@ -95,7 +95,7 @@ print(json.dumps([b - a for a, b in zip(marks, marks[1:])]))
 """
 PHASE_NAMES = (
     "import numba (and scipy, for its version check)",
-    "import tumble.rigid.kernels (define the dispatchers)",
+    "import tumble.rigid._compiled.flows (define the dispatchers)",
     "numba's compiler context (its registries, scipy.linalg for BLAS, its runtime)",
     "simulate: load the cached loop, link it, run",
 )

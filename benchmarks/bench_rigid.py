@@ -263,18 +263,18 @@ def kernel_run(problem: Problem, method: str, h: float) -> np.ndarray:
     ``simulate``'s checks, initial state and trajectory (the floor of a ``simulate`` call);
     returns R(T)."""
     from tumble.ode.driver import Grid
-    from tumble.rigid import kernels
+    from tumble.rigid._compiled import base, charts
     from tumble.rigid.charts import LIE
     from tumble.rigid.methods import METHODS
 
     tableau = METHODS[method].tableau
     n, zero, none = round(T_END / h), np.zeros(3), np.zeros((0, 3))
     z, Rn = LIE.pack(np.eye(3), np.concatenate([zero, zero, problem.omega0 * problem.inertia]))
-    data = kernels.Problem(True, tableau.A, tableau.b, problem.body.inertia_inverse,
+    data = base.KernelProblem(True, tableau.A, tableau.b, problem.body.inertia_inverse,
                            problem.body.mass, zero, zero, none, none, np.eye(3),
                            np.ones(3))  # fmt: skip
-    record = kernels.Records(np.empty(1), np.empty((1, 3, 3)), np.empty((1, 4)), np.empty((1, 9)))
-    kernels.COMPILED["lie"].loop(data, Grid(0.0, T_END, h, n), z, Rn, 0, n, 10**9, 0, record)
+    record = base.Records(np.empty(1), np.empty((1, 3, 3)), np.empty((1, 4)), np.empty((1, 9)))
+    charts.COMPILED["lie"].loop(data, Grid(0.0, T_END, h, n), (z, Rn), 0, n, 10**9, 0, record)
     return Rn
 
 
@@ -607,9 +607,9 @@ def split_axes_floors(steps: int = 1_000_000) -> dict[str, float]:
     ``free5``, :func:`sin_cos_free` with five; ``alone``, the kernels' axes flow called as the
     loop calls it between records (four turns: the merged one by h, none at the end), in a
     compiled loop without the driver around it."""
-    from tumble.rigid import kernels
+    from tumble.rigid._compiled import exact_flow, flows
 
-    flow = kernels._axes_flow
+    flow = flows._axes_flow
 
     @njit
     def flows(n, Rp, L, moments, h, work):
@@ -618,7 +618,7 @@ def split_axes_floors(steps: int = 1_000_000) -> dict[str, float]:
         return Rp
 
     L, moments = np.array([0.45, 0.0, 0.89]), np.array([2.0 / 3.0, 1.0, 2.0])
-    work = np.empty(kernels.WORK_SIZE)
+    work = np.empty(exact_flow.WORK_SIZE)
     floors = {
         "chain5": lambda: sin_cos_chain(steps, 5, 0.01),
         "chain4": lambda: sin_cos_chain(steps, 4, 0.01),

@@ -183,7 +183,7 @@ def test_the_distance_to_the_separatrix_drifts_by_about_rtol_through_a_flip(meth
 def test_the_compiled_norm_is_the_python_norm():
     # The compiled adaptive loop calls charts.error_norm compiled; on the same step the two
     # agree to a few ulps (sin and the sums round alike; no cancellation in these states).
-    from tumble.rigid.kernels import _ERROR_NORM
+    from tumble.rigid._compiled.charts import _ERROR_NORM
 
     rng = np.random.default_rng(11)
     D = separatrix_form(np.diag(MOMENTS))

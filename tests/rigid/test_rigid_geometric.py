@@ -17,9 +17,9 @@ from tumble.rigid import (
     RigidBody,
     Torque,
     geometric,
-    kernels,
     simulate,
 )
+from tumble.rigid._compiled import exact_flow, flows
 from tumble.scenarios.t_handle import SPINS
 
 INERTIA = np.array([2.0, 1.0, 2.0 / 3.0])
@@ -131,8 +131,8 @@ def test_kernel_matches_reference_with_every_load(method):
 
 
 def test_kernels_and_reference_share_the_newton_budget():
-    assert kernels.NEWTON_MAX == geometric.NEWTON_MAX
-    assert kernels.NEWTON_TOL == geometric.NEWTON_TOL
+    assert flows.NEWTON_MAX == geometric.NEWTON_MAX
+    assert flows.NEWTON_TOL == geometric.NEWTON_TOL
 
 
 def compass(method: str, h: float, t_end: float, **options):
@@ -383,10 +383,15 @@ def test_exact_with_a_load_is_refused_pointing_to_the_splittings():
 def test_exact_flow_constants_agree_with_the_elliptic_module():
     from tumble import _elliptic
 
-    assert kernels.SYMMETRY_RTOL == _elliptic.SYMMETRY_RTOL
-    assert kernels.SEPARATRIX_RTOL == _elliptic.SEPARATRIX_RTOL
-    assert kernels.M1_MIN == _elliptic.M1_MIN and kernels.AGM_MAX_STEPS == _elliptic.AGM_MAX_STEPS
-    assert kernels.M1_SERIES == _elliptic.M1_SERIES and kernels.NU_SPLIT == _elliptic.NU_SPLIT
+    assert exact_flow.SYMMETRY_RTOL == _elliptic.SYMMETRY_RTOL
+    assert exact_flow.SEPARATRIX_RTOL == _elliptic.SEPARATRIX_RTOL
+    assert (
+        exact_flow.M1_MIN == _elliptic.M1_MIN
+        and exact_flow.AGM_MAX_STEPS == _elliptic.AGM_MAX_STEPS
+    )
+    assert (
+        exact_flow.M1_SERIES == _elliptic.M1_SERIES and exact_flow.NU_SPLIT == _elliptic.NU_SPLIT
+    )
 
 
 def test_compiled_carlson_integrals_match_scipy():
@@ -398,9 +403,9 @@ def test_compiled_carlson_integrals_match_scipy():
         p = rng.uniform(0.01, 3)
         # the compiled duplication (numba: no FMA, no reassociation, only sqrt) gives the same
         # bits on any machine; its truncation and round-off measured against scipy's
-        assert kernels._carlson_rf(x, y, z) == pytest.approx(elliprf(x, y, z), rel=4e-15)
-        assert kernels._carlson_rj(x, y, z, p) == pytest.approx(elliprj(x, y, z, p), rel=4e-15)
-    assert kernels._carlson_rf(0.0, 1e-300, 1.0) == pytest.approx(elliprf(0.0, 1e-300, 1.0))
+        assert exact_flow._carlson_rf(x, y, z) == pytest.approx(elliprf(x, y, z), rel=4e-15)
+        assert exact_flow._carlson_rj(x, y, z, p) == pytest.approx(elliprj(x, y, z, p), rel=4e-15)
+    assert exact_flow._carlson_rf(0.0, 1e-300, 1.0) == pytest.approx(elliprf(0.0, 1e-300, 1.0))
 
 
 @pytest.mark.parametrize("method", ON_EXACT)

@@ -80,7 +80,8 @@ def test_record_every_keeps_every_kth_step_and_the_last(body):
 @pytest.mark.parametrize("method", ["lie-euler", "seed-rk4", "rkmk4", "rkmk8"])
 def test_kernel_matches_reference_for_large_rotations_per_step(body, method, h):
     # |ω| ≈ 2.7 rad/s: h = 0.08 turns ≈ 0.22 rad per step, near the end of the kernels'
-    # Taylor series for exp and dexp⁻¹ (kernels.SERIES_ANGLE = 0.25), where their truncation
+    # Taylor series for exp and dexp⁻¹ (SERIES_ANGLE = 0.25 in rigid/_compiled/charts.py), where
+    # their truncation
     # matters most; h = 0.3 turns ≈ 0.8 rad, on their sin/cos branch. The test above stays at
     # 0.01 rad.
     options = dict(method=method, h=h, omega0=(1.0, 2.0, -1.5), forces=FORCES[:2])

@@ -19,7 +19,8 @@ import pytest
 
 from tumble import exact, mass
 from tumble._elliptic import SEPARATRIX_RTOL
-from tumble.rigid import RigidBody, geometric, kernels, simulate
+from tumble.rigid import RigidBody, geometric, simulate
+from tumble.rigid._compiled import exact_flow
 
 EPS = float(np.finfo(float).eps)
 DIGITS = 40
@@ -251,13 +252,13 @@ def test_jacobi_functions_keep_a_small_cn_and_dn_to_a_few_ulps(m1):
     co_quarter = _elliptic.complete_first(m) if m1 < _elliptic.M1_SERIES else np.inf
     r = K * np.array([-0.999, -0.9, -0.6, -0.3, 0.01, 0.45, 0.55, 0.8, 0.99999])
     reference_values = _elliptic.jacobi_reduced(r, m, m1, K, co_quarter)
-    work = np.empty(kernels.WORK_SIZE)
+    work = np.empty(exact_flow.WORK_SIZE)
     with mp.workdps(DIGITS + 40):
         mm = 1 - mp.mpf(m1)
         for k, x in enumerate(r):
             sn, cn, dn = (mp.ellipfun(kind, mp.mpf(x), mm) for kind in ("sn", "cn", "dn"))
             slopes = (cn * dn, sn * dn, mm * sn * cn)  # |d/du| of sn, cn, dn
-            kernel = kernels._jacobi_reduced(x, m, m1, K, co_quarter, work)
+            kernel = exact_flow._jacobi_reduced(x, m, m1, K, co_quarter, work)
             for i, exact_value in enumerate((sn, cn, dn)):
                 bound = STEP_ULPS * EPS * float(abs(exact_value) + K * abs(slopes[i]))
                 assert abs(float(reference_values[i][k] - exact_value)) <= bound, (k, i)
@@ -328,8 +329,8 @@ def test_one_exact_step_compiled_is_its_reference(start, distance):
     omega0 = start(moments, distance)
     L = P.T @ (moments * omega0)  # the world momentum with R_p = Id
     R = geometric.exact_flow(np.eye(3), L, sorted_moments, 7.0)
-    Rk, work = np.eye(3), np.empty(kernels.WORK_SIZE)
-    kernels._exact_flow(Rk, L[0], L[1], L[2], sorted_moments, 7.0, work, 1.0, 1.0)
+    Rk, work = np.eye(3), np.empty(exact_flow.WORK_SIZE)
+    exact_flow._exact_flow(Rk, L[0], L[1], L[2], sorted_moments, 7.0, work, 1.0, 1.0)
     closed, _ = reference(moments, omega0)
     assert np.abs(Rk - R).max() < 2 * step_bound(closed, 7.0)
 

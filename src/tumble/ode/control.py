@@ -59,7 +59,7 @@ def step_factor(
     ``s ‖e‖^(−1/(q+1))`` bounded to ``[min_factor, max_factor]`` (to 1 after a rejection or
     for a rejected step); a non-finite norm shrinks by ``min_factor``. Plain scalar code, so
     that :class:`StepController` and the compiled adaptive loops of
-    :mod:`tumble.rigid.kernels` (which compile this very function) share it.
+    :mod:`tumble.rigid._compiled` (which compile this very function) share it.
     """
     if not math.isfinite(error_norm):
         return min_factor

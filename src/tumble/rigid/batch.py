@@ -5,7 +5,7 @@ alone with body ``k``'s arguments. The ``lie`` and ``quat`` methods (``rkmk4``, 
 …) run batches of at least :data:`SOA_MIN_BODIES` bodies in the structure-of-arrays loops of
 :mod:`tumble.rigid.soa` (bodies as columns, vectorised, the one-body loop's numbers bit for
 bit); the other methods, and smaller batches, run the one-body loop of
-:mod:`tumble.rigid.kernels` once per body, one body per thread (numba ``prange``). The
+:mod:`tumble.rigid._compiled` once per body, one body per thread (numba ``prange``). The
 initial states are checked and built for all bodies at once with NumPy (the same operations
 ``simulate`` applies to one body).
 """
@@ -470,7 +470,7 @@ class BatchStepper(Stepper):
     (time). A body whose state stops being finite stops alone: the block goes on for the
     others, and :attr:`counts` and :attr:`failed` say, per body, how many samples it
     recorded and at which step it stopped (-1: none); :attr:`causes` why
-    (:data:`~tumble.rigid.kernels.NON_FINITE` or ``UNCONVERGED``).
+    (:data:`~tumble.rigid._compiled.base.NON_FINITE` or ``UNCONVERGED``).
     ``split`` methods carry ``R_p = R P`` with each body's principal axes ``P``.
     """
 
@@ -478,7 +478,8 @@ class BatchStepper(Stepper):
     time_axis = 1
 
     def __init__(self, method: Method, problem):
-        from tumble.rigid.kernels import COMPILED, COMPILED_FLOWS
+        from tumble.rigid._compiled.charts import COMPILED
+        from tumble.rigid._compiled.flows import COMPILED_FLOWS
 
         self.method, self.problem = method, problem
         self.split = method.family == "split"
@@ -509,7 +510,7 @@ class BatchStepper(Stepper):
         return self._matrix(attitude)[:, None], Y[:, None], q
 
     def march_block(self, state, grid: Grid, k0: int, k1: int, every: int, step0: int) -> Block:
-        from tumble.rigid.kernels import Records
+        from tumble.rigid._compiled.base import Records
 
         if (k0, k1, step0) != (0, grid.n, 0):
             raise NotImplementedError("a batch marches its whole grid in one block")
@@ -627,7 +628,7 @@ def _end_stopped_bodies(samples, last, times, counts, failed, grid):
 def _messages(spec: Method, failed: np.ndarray, causes: np.ndarray, grid: Grid) -> list[str]:
     """Per body, ``simulate``'s message: the end reached, the step that was not finite, or
     the step whose implicit flow did not converge."""
-    from tumble.rigid.kernels import UNCONVERGED
+    from tumble.ode.contract import UNCONVERGED
 
     messages = [Status.SUCCESS.message] * len(failed)
     for k in np.flatnonzero(failed >= 0):

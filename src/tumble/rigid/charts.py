@@ -19,7 +19,7 @@ is Runge–Kutta–Munthe-Kaas (Munthe-Kaas 1998): the right-trivialised equatio
 ``R_{n+1} = R_n exp(û_{n+1})`` on SO(3) to round-off.
 
 A chart is Python data here (pack, map back, vector field) and a compiled twin in
-:mod:`tumble.rigid.kernels` (a numba field, map back and record), which a test checks
+:mod:`tumble.rigid._compiled` (a numba field, map back and record), which a test checks
 against this reference to round-off. Adding a family costs one :class:`Chart`, its Python
 field, and its numba field.
 """
@@ -191,7 +191,7 @@ def error_norm(error, z, z_new, Rn, rtol, atol, separatrix, share):
       ``|m|²``; its relative error sets the flip times, and through them the attitude.
 
     Plain scalar code: the Python stepper calls it and the compiled adaptive loop of
-    :mod:`tumble.rigid.kernels` compiles this same function and its helpers
+    :mod:`tumble.rigid._compiled` compiles this same function and its helpers
     (:data:`NORM_HELPERS`). A NaN anywhere gives NaN (the step is rejected); an error of
     exactly zero counts as zero.
     """
@@ -284,7 +284,7 @@ def _transpose_apply(M, v0, v1, v2):
 def _rotate(a, b, u0, u1, u2, v0, v1, v2):
     """``v + a u×v + b u×(u×v)``: ``exp(±û) v`` for ``(±sin θ/θ, (1 − cos θ)/θ²)``,
     ``dexp_{−u} v`` for ``(−(1 − cos θ)/θ², (1 − sin θ/θ)/θ²)``, ``dexp⁻¹_{−u} v`` for
-    ``(½, α)`` (:mod:`tumble.rigid.kernels` compiles this one for its loops too)."""
+    ``(½, α)`` (:mod:`tumble.rigid._compiled` compiles this one for its loops too)."""
     c0, c1, c2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
     d0, d1, d2 = u1 * c2 - u2 * c1, u2 * c0 - u0 * c2, u0 * c1 - u1 * c0
     return v0 + a * c0 + b * d0, v1 + a * c1 + b * d1, v2 + a * c2 + b * d2
@@ -294,7 +294,7 @@ NORM_HELPERS = (
     "_separatrix_drift", "_mixed", "_largest", "_exp_coefficients", "_apply",
     "_transpose_apply", "_rotate",
 )  # fmt: skip
-"""The functions :func:`error_norm` calls, compiled beside it by :mod:`tumble.rigid.kernels`."""
+"""The functions :func:`error_norm` calls, compiled beside it by :mod:`tumble.rigid._compiled`."""
 
 
 def _lie_first_same_as_last(K: np.ndarray, z_new: np.ndarray) -> np.ndarray:

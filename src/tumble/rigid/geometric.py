@@ -55,7 +55,7 @@ The two implicit flows are solved by Newton's method (a 3 × 3 system) to round-
 :func:`split_step` is one step of a ``split`` method with loads: the symmetric
 ``K(h/2) ∘ D(h) ∘ K(h/2)``, kicks ``(p, L) += (h/2)(F, τ)`` around the drift ``x += h p/m``
 and the flow, composed with the method's weights. Its compiled twin is in
-:mod:`tumble.rigid.kernels`; ``tests/rigid`` checks that they agree to round-off.
+:mod:`tumble.rigid._compiled`; ``tests/rigid`` checks that they agree to round-off.
 
 References
 ----------

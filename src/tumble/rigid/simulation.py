@@ -36,7 +36,7 @@ from tumble.rigid.steppers import (
 from tumble.rigid.trajectory import Solution, Trajectory
 
 if TYPE_CHECKING:
-    from tumble.rigid.kernels import Problem
+    from tumble.rigid._compiled.base import KernelProblem
 
 log = logging.getLogger(__name__)
 
@@ -55,18 +55,18 @@ def _jumps(stepper: BodyStepper, impulses, t0: float, t_end: float) -> list[Jump
     return [(time, stepper.kick([imp for imp in impulses if imp.time == time])) for time in times]
 
 
-def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> Problem:
-    """The kernels' :class:`~tumble.rigid.kernels.Problem` for ``method`` and constant
-    ``loads`` (:func:`~tumble.rigid.forces.compiled_loads`); ``axes``, ``moments`` are the
-    principal frame (``split`` methods; with a leading body axis in a batch)."""
-    from tumble.rigid.kernels import Problem  # numba only when a compiled run needs it
+def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> KernelProblem:
+    """The kernels' :class:`~tumble.rigid._compiled.base.KernelProblem` for ``method`` and
+    constant ``loads`` (:func:`~tumble.rigid.forces.compiled_loads`); ``axes``, ``moments``
+    are the principal frame (``split`` methods; with a leading body axis in a batch)."""
+    from tumble.rigid._compiled.base import KernelProblem  # numba only for a compiled run
 
     if method.tableau is None:
         A, b = np.zeros((0, 0)), np.array(method.weights)
     else:
         A, b = method.tableau.A, method.tableau.b
     F, tau, points, point_forces = loads
-    return Problem(method.dexpinv, A, b, inertia_inverse, mass, F, tau, points, point_forces,
+    return KernelProblem(method.dexpinv, A, b, inertia_inverse, mass, F, tau, points, point_forces,
                    axes, moments)  # fmt: skip
 
 

@@ -1,31 +1,31 @@
 """Structure-of-arrays batch loops: bodies side by side, so the loops over bodies vectorise.
 
 :func:`~tumble.rigid.simulate_batch` runs every body through the one-body loop of
-:mod:`tumble.rigid.kernels` (one body at a time per thread: "array of structures"). Here the
-``lie`` and ``quat`` charts (``rkmk4``, ``rkmk8``, ``lie-euler``, ``seed-rk4``, ``rk4-quat``,
-``euler-quat``) get a second loop in which the bodies are columns: :func:`run_batch` takes
-the batch as it is (``Z`` (N, nz), ``R_n`` (N, 3, 3), the body data in the
-:class:`~tumble.rigid.kernels.Problem`) and each block of :data:`BLOCK` bodies copies its
-columns into contiguous work arrays (``z`` (nz, B), ``R_n`` (9, B), ``I⁻¹`` (9, B), ``m``
-(B,), ``F`` (3, B)), marches them over the whole grid and copies them back; the blocks run in
-parallel (``prange``), so the transposes do too. Each stage is a few loops over the bodies
-of the block whose bodies are plain arithmetic on contiguous rows, so LLVM turns them into
-packed (SIMD) instructions (``tests/rigid/test_rigid_batch.py`` checks the assembly for
-packed ``vmulpd``). What keeps them packed: no call and no branch in a loop over bodies (the
-rare branches run as a second, scalar loop after it), and few rows written per loop (a loop
-that also wrote the nine rows of the loads was judged not worth vectorising). What makes
-them cheap: a stage sum keeps up to four terms in a register (:func:`_combine`: one pass
-over the rows instead of one per term), the positions, which no field reads, get no stage
-sum, and the exp and dexp⁻¹ series take one loop for all bodies.
+:mod:`tumble.rigid._compiled` (one body at a time per thread: "array of structures"). Here
+the ``lie`` and ``quat`` charts (``rkmk4``, ``rkmk8``, ``lie-euler``, ``seed-rk4``,
+``rk4-quat``, ``euler-quat``) get a second loop in which the bodies are columns:
+:func:`run_batch` takes the batch as it is (``Z`` (N, nz), ``R_n`` (N, 3, 3), the body data
+in the :class:`~tumble.rigid._compiled.base.KernelProblem`) and each block of :data:`BLOCK`
+bodies copies its columns into contiguous work arrays (``z`` (nz, B), ``R_n`` (9, B),
+``I⁻¹`` (9, B), ``m`` (B,), ``F`` (3, B)), marches them over the whole grid and copies them
+back; the blocks run in parallel (``prange``), so the transposes do too. Each stage is a few
+loops over the bodies of the block whose bodies are plain arithmetic on contiguous rows, so
+LLVM turns them into packed (SIMD) instructions (``tests/rigid/test_rigid_batch.py`` checks
+the assembly for packed ``vmulpd``). What keeps them packed: no call and no branch in a loop
+over bodies (the rare branches run as a second, scalar loop after it), and few rows written
+per loop (a loop that also wrote the nine rows of the loads was judged not worth
+vectorising). What makes them cheap: a stage sum keeps up to four terms in a register
+(:func:`_combine`: one pass over the rows instead of one per term), the positions, which no
+field reads, get no stage sum, and the exp and dexp⁻¹ series take one loop for all bodies.
 
 The arithmetic is the one-body loop's, operation for operation in the same order
-(:func:`~tumble.rigid.kernels._lie_field`, ``_quat_field``, ``_loads``, the stage sums, less
-the zero terms of a tableau, which change no number: :func:`_terms`): no fastmath, so no
+(:func:`~tumble.rigid._compiled.charts._lie_field`, ``_quat_field``, ``_loads``, the stage
+sums, less the zero terms of a tableau, which change no number: :func:`_terms`): no fastmath, so no
 reassociation or fused multiply-add, and every body gets bit for bit the numbers of
 :func:`~tumble.rigid.simulate` (the batch tests compare with ``assert_array_equal``).
 The two branches of that arithmetic become: the ``exp`` and ``dexp⁻¹`` coefficients from
 their series for all bodies (a vector loop), then the few bodies whose angle is at least
-:data:`~tumble.rigid.kernels.SERIES_ANGLE` recomputed by the one-body functions (a scalar
+:data:`~tumble.rigid._compiled.charts.SERIES_ANGLE` recomputed by the one-body functions (a scalar
 loop); a body whose new state is not finite stops alone, as in the one-body loop (its state
 is left at the step before; the test ``Σ 0·x == 0`` on its numbers is vectorised,
 the bookkeeping of a stop is scalar and rare).
@@ -38,16 +38,13 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from tumble.rigid.kernels import (
-    _JIT,
+from tumble.rigid._compiled.base import _JIT, _cross, _quat_matrix, _rotate
+from tumble.rigid._compiled.charts import (
     _SERIES2,
-    _cross,
     _dexpinv_coefficient,
     _dexpinv_series,
     _exp_coefficients,
     _exp_series,
-    _quat_matrix,
-    _rotate,
 )
 
 BLOCK = 256
@@ -152,7 +149,7 @@ def _new_state(stage, h, z, K, zn, bad):
 
 @njit(**_JIT)
 def _loads_soa(off, zs, m, F, tau, K, i):
-    """:func:`~tumble.rigid.kernels._loads` but the points' for every body: ``ẋ = p/m``,
+    """:func:`~tumble.rigid._compiled.base._loads` but the points' for every body: ``ẋ = p/m``,
     ``ṗ = F``, ``L̇ = τ`` (rows ``off …`` of ``K[i]``; ``zs[off:]`` = ``(x, p, L)``)."""
     t0, t1, t2 = tau[0], tau[1], tau[2]
     for j in range(m.shape[0]):
@@ -165,7 +162,7 @@ def _loads_soa(off, zs, m, F, tau, K, i):
 
 @njit(**_JIT)
 def _point_loads(off, R, u, a, b, points, point_forces, K, i):
-    """The point loads of :func:`~tumble.rigid.kernels._loads` for every body:
+    """The point loads of :func:`~tumble.rigid._compiled.base._loads` for every body:
     ``ṗ += f_k``, ``L̇ += (R exp(û) r_k) × f_k`` (``R`` (9, B) row-major; ``u`` (3, B))."""
     n = K.shape[2]
     for k in range(points.shape[0]):
@@ -189,7 +186,7 @@ def _point_loads(off, R, u, a, b, points, point_forces, K, i):
 def _coefficients(u, coefficients, dexpinv):
     """Per body: exp's ``(a, b)`` for ``θ²`` of ``u`` (rows 0 … 2 of ``u``) and, if
     ``dexpinv``, dexp⁻¹'s ``α`` into the rows of ``coefficients`` (3, B): the series for all
-    bodies in one vector loop, then the exact forms (:func:`~tumble.rigid.kernels.
+    bodies in one vector loop, then the exact forms (:func:`~tumble.rigid._compiled.charts.
     _exp_coefficients`, ``_dexpinv_coefficient``) for the few bodies whose angle is not
     small."""
     n = u.shape[1]
@@ -210,8 +207,8 @@ def _coefficients(u, coefficients, dexpinv):
 
 @njit(**_JIT)
 def _lie_field_soa(correct, zs, Rn, inv_I, m, F, tau, coefficients, K, i):
-    """:func:`~tumble.rigid.kernels._lie_field` and the loads but the points'
-    (:func:`~tumble.rigid.kernels._loads`) for every body: ``u̇ = dexp⁻¹_{−u}(ω)``,
+    """:func:`~tumble.rigid._compiled.charts._lie_field` and the loads but the points'
+    (:func:`~tumble.rigid._compiled.base._loads`) for every body: ``u̇ = dexp⁻¹_{−u}(ω)``,
     ``ω = I⁻¹ exp(−û) R_nᵀ L``; ``coefficients`` (3, B) gets exp's ``(a, b)`` and dexp⁻¹'s
     ``α`` (:func:`_coefficients`), then a vector loop does the field, :func:`_loads_soa` the
     loads."""
@@ -237,7 +234,7 @@ def _lie_field_soa(correct, zs, Rn, inv_I, m, F, tau, coefficients, K, i):
 @njit(**_JIT)
 def _lie_turn_soa(zn, Rn, coefficients, alive):
     """``R_n ← R_n exp(û)`` for the living bodies (row r of the product is ``exp(−û)`` of
-    row r), ``u`` from ``zn``: :func:`~tumble.rigid.kernels._lie_advance` but ``z``."""
+    row r), ``u`` from ``zn``: :func:`~tumble.rigid._compiled.charts._lie_advance` but ``z``."""
     _coefficients(zn, coefficients, False)
     for j in range(Rn.shape[1]):
         u0, u1, u2 = zn[0, j], zn[1, j], zn[2, j]
@@ -252,7 +249,7 @@ def _lie_turn_soa(zn, Rn, coefficients, alive):
 
 @njit(**_JIT)
 def _quat_field_soa(zs, R, inv_I, m, F, tau, K, i):
-    """:func:`~tumble.rigid.kernels._quat_field` and the loads but the points' for every
+    """:func:`~tumble.rigid._compiled.charts._quat_field` and the loads but the points' for every
     body: ``q̇ = ½ q ⊗ (0, ω)``, ``ω = I⁻¹ Rᵀ L`` with ``R = R(q/|q|)`` written to ``R``
     (9, B) (two loops: each vectorises)."""
     n = zs.shape[1]
@@ -283,7 +280,7 @@ def _quat_field_soa(zs, R, inv_I, m, F, tau, K, i):
 
 @njit(**_JIT)
 def _quat_start_soa(z):
-    """:func:`~tumble.rigid.kernels._quat_start`: ``q ← q/|q|`` for every body."""
+    """:func:`~tumble.rigid._compiled.charts._quat_start`: ``q ← q/|q|`` for every body."""
     for j in range(z.shape[1]):
         norm = math.sqrt(z[0, j] ** 2 + z[1, j] ** 2 + z[2, j] ** 2 + z[3, j] ** 2)
         for c in range(4):
@@ -385,8 +382,8 @@ def run_batch(quat, problem, grid, Z, RN, every, records, counts, failed):
     """Every body of a batch, :data:`BLOCK` at a time in parallel: ``Z`` (N, nz), ``RN``
     (N, 3, 3) (end as the last states), body ``k``'s data ``problem.inv_I[k]`` (3, 3),
     ``problem.m[k]``, ``problem.F[k]`` (3,) and the shared loads (:class:`~tumble.rigid.
-    kernels.Problem`); each block works on its bodies as columns (copied in and out).
-    ``records``, ``counts``, ``failed`` as for :func:`~tumble.rigid.kernels._batch` (the
+    _compiled.base.KernelProblem`); each block works on its bodies as columns (copied in and out).
+    ``records``, ``counts``, ``failed`` as for :func:`~tumble.rigid._compiled.charts._batch` (the
     cause of a stop is always ``NON_FINITE``)."""
     n_bodies = Z.shape[0]
     for block in prange((n_bodies + BLOCK - 1) // BLOCK):

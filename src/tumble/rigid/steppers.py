@@ -3,7 +3,7 @@
 :class:`RigidStepper` is the readable NumPy reference: one :func:`~tumble.ode.stepper.rk_step`
 of the method's tableau in the method's chart (:mod:`tumble.rigid.charts`).
 :class:`CompiledStepper` marches whole blocks of a fixed grid in the chart's numba loop
-(:mod:`tumble.rigid.kernels`), the same algorithm; ``tests/rigid`` checks they agree to
+(:mod:`tumble.rigid._compiled`), the same algorithm; ``tests/rigid`` checks they agree to
 round-off. Both plug into :func:`tumble.ode.driver.march`, which owns the time loop.
 
 :class:`SplitStepper` and :class:`CompiledSplitStepper` are the same pair for the ``split``
@@ -23,6 +23,7 @@ import numpy as np
 
 from tumble import so3
 from tumble._progress import announce_compilation
+from tumble.ode.contract import FAILURES
 from tumble.ode.dense import StepInterpolant, step_coefficients
 from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Stepper, non_finite_message
 from tumble.ode.stepper import rk_step
@@ -218,13 +219,14 @@ class CompiledStepper(RigidStepper):
     """:class:`RigidStepper` whose fixed grids march in the chart's compiled loop, and whose
     adaptive steps (``rkmk45``, ``rkmk-dopri5``) run in the chart's compiled adaptive loop.
 
-    ``problem`` is the kernels' :class:`~tumble.rigid.kernels.Problem` (constant loads).
+    ``problem`` is the kernels' :class:`~tumble.rigid._compiled.base.KernelProblem` (constant
+    loads).
     """
 
     blocks = True
 
     def __init__(self, method: Method, dynamics: Dynamics, problem):
-        from tumble.rigid.kernels import COMPILED
+        from tumble.rigid._compiled.charts import COMPILED
 
         super().__init__(method, dynamics)
         self.problem, self.loop = problem, COMPILED[self.chart.name].loop
@@ -243,9 +245,10 @@ class CompiledStepper(RigidStepper):
                     tableau.error_order, float(control.horizon or 0.0))  # fmt: skip
         atol = np.broadcast_to(np.asarray(control.atol, dtype=float), (9,)).copy()
         announce_compilation(self.adaptive_loop, f"the {self.chart.name} chart's adaptive loop")
-        count, t_end, h_next, accepted, rejected, code, t_failed, finite = self.adaptive_loop(
-            self.problem, tableau.e, t, t1, h, control.rtol, atol, self.separatrix, settings,
-            self._fsal, z, Rn, every, step0, float(max_steps), records,
+        tolerances = (tableau.e, control.rtol, atol, self.separatrix)
+        count, t_end, h_next, accepted, rejected, cause, t_failed, finite = self.adaptive_loop(
+            (self.problem, tolerances), t, t1, h, settings, self._fsal, (z, Rn), every, step0,
+            float(max_steps), records,
         )  # fmt: skip
         q = records.q[:count] if self._quat else np.empty((count, 0))
         return AdaptiveBlock(
@@ -256,7 +259,7 @@ class CompiledStepper(RigidStepper):
             h=h_next,
             n_steps=accepted,
             n_rejected=rejected,
-            failure={0: None, 1: "non-finite", 2: "minimum-step"}[code],
+            failure=FAILURES[cause],
             t_failed=t_failed,
             finite=finite,
         )
@@ -267,7 +270,7 @@ class CompiledStepper(RigidStepper):
         records = _records((k1 - k0) // every + 1)
         z, Rn = self.chart.pack(*state)
         announce_compilation(self.loop, f"the {self.chart.name} chart's loop")
-        count, failed, _ = self.loop(self.problem, grid, z, Rn, k0, k1, every, step0, records)
+        count, failed, _ = self.loop(self.problem, grid, (z, Rn), k0, k1, every, step0, records)
         q = records.q[:count] if self._quat else np.empty((count, 0))
         return Block(
             t=records.t[:count],
@@ -278,7 +281,7 @@ class CompiledStepper(RigidStepper):
 
 
 def _records(size: int):
-    from tumble.rigid.kernels import Records
+    from tumble.rigid._compiled.base import Records
 
     return Records(np.empty(size), np.empty((size, 3, 3)), np.empty((size, 4)),
                    np.empty((size, 9)))  # fmt: skip
@@ -290,7 +293,7 @@ class CompiledSplitStepper(SplitStepper):
     blocks = True
 
     def __init__(self, method: Method, dynamics: Dynamics, problem):
-        from tumble.rigid.kernels import COMPILED_FLOWS
+        from tumble.rigid._compiled.flows import COMPILED_FLOWS
 
         super().__init__(method, dynamics, (problem.moments, problem.axes))
         assert method.flow is not None
@@ -299,12 +302,12 @@ class CompiledSplitStepper(SplitStepper):
     def march_block(
         self, state: RigidState, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
-        from tumble.rigid.kernels import UNCONVERGED
+        from tumble.ode.contract import UNCONVERGED
 
         records = _records((k1 - k0) // every + 1)
         Rp, Y = np.array(state[0], dtype=float), np.array(state[1], dtype=float)
         announce_compilation(self.loop, f"the {self.method.flow} flow's loop")
-        count, failed, cause = self.loop(self.problem, grid, Y, Rp, k0, k1, every, step0,
+        count, failed, cause = self.loop(self.problem, grid, (Y, Rp), k0, k1, every, step0,
                                          records)  # fmt: skip
         self.unconverged = failed >= 0 and cause == UNCONVERGED
         return Block(
