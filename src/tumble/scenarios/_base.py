@@ -127,3 +127,58 @@ def mesh_dataset(mesh, *, shows: str):
 def rigid_attrs(body, **settings: Any) -> dict[str, Any]:
     """The root attributes of ``data.nc`` for a rigid-body scenario: settings, mass, inertia."""
     return {**settings, "mass": float(body.mass), "inertia": np.ravel(body.inertia).tolist()}
+
+
+VIEW_FILE = "view.html"
+"""The interactive viewer's page in a run folder."""
+
+
+def view_page(run_dir: str | Path) -> Path:
+    """The run's ``view.html``, drawn again from ``data.nc`` when it is not there.
+
+    A page the run's ``summary.json`` does not list (left by an earlier run) is drawn again
+    too. The run shown and the body come from ``data.nc``'s ``mesh`` group
+    (:func:`rigid_datasets`).
+
+    Raises
+    ------
+    ValueError
+        If ``run_dir`` is not a complete run folder (:func:`tumble.io.load`), or its run has
+        no body mesh (a projectile, a beam).
+    """
+    run_dir = Path(run_dir)
+    page = run_dir / VIEW_FILE
+    if page.is_file() and _listed(run_dir, page.name):
+        return page
+    import trimesh
+
+    from tumble._atomic import atomic_write
+    from tumble.io import load
+    from tumble.rigid import Trajectory
+    from tumble.viz.html import html_viewer
+
+    run = load(run_dir)
+    if "mesh" not in run.groups:
+        raise ValueError(
+            f"run_dir={str(run_dir)!r} holds no body mesh (scenario "
+            f"{run.attrs.get('scenario')!r}); the viewer shows rigid-body runs only"
+        )
+    mesh_data = run.dataset("mesh")
+    mesh = trimesh.Trimesh(mesh_data["vertices"].values, mesh_data["faces"].values, process=False)
+    shows = mesh_data.attrs["shows"]
+    trajectory = Trajectory.from_xarray(run.dataset(shows))
+    title = f"{run.attrs.get('scenario')} — {f'{shows}, ' if shows else ''}{trajectory.method}"
+    atomic_write(page, lambda tmp: html_viewer(trajectory, mesh, tmp, title=title))
+    return page
+
+
+def _listed(run_dir: Path, name: str) -> bool:
+    """Whether the run's ``summary.json`` lists ``name`` (a file of this run, not a stale one)."""
+    import json
+
+    from tumble.io import SUMMARY_FILE
+
+    try:
+        return name in json.loads((run_dir / SUMMARY_FILE).read_text(encoding="utf-8"))["files"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return False
