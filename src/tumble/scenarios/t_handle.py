@@ -73,11 +73,63 @@ def zero_crossings(t: np.ndarray, values: np.ndarray) -> np.ndarray:
     return t[k] - values[k] * (t[k + 1] - t[k]) / (values[k + 1] - values[k])
 
 
-def measured_period(t: np.ndarray, omega: np.ndarray) -> tuple[float | None, int, np.ndarray]:
-    """The period of ω_body(t) from the zero crossings of its most-crossing component.
+def measured_periods(t: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """The period of each run's ω_body(t), from the zero crossings of its most-crossing component.
 
     Every other crossing is in the same direction, one period later; the period is the mean
-    of ``c[k + 2] − c[k]``.
+    of ``c[k + 2] − c[k]`` over the crossings ``c`` (:func:`zero_crossings`: a zero counts
+    as positive, linear interpolation between samples). That mean telescopes to
+    ``(c[-1] + c[-2] − c[0] − c[1]) / (len(c) − 2)``, so only the first two and last two
+    crossings of each run are located: many runs at once cost a few array passes (a sweep's
+    ``flip_period``, :mod:`tumble.sweeps.variables`).
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Times (s), shared by every run.
+    omega : ndarray, shape (m, n, 3)
+        Body angular velocities (rad/s); NaN after a run that stopped.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The periods (s); NaN where fewer than three crossings were seen (run longer).
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 20.0, 2001)
+    >>> spins = np.stack([np.cos(t), np.sin(t), np.ones_like(t)], axis=1)
+    >>> np.round(measured_periods(t, np.stack([spins, spins[:, [2, 0, 1]]])), 5)
+    array([6.28319, 6.28319])
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        positive = omega >= 0
+        changes = positive[:, :-1] != positive[:, 1:]  # (m, n - 1, 3)
+        component = np.argmax(changes.sum(axis=1), axis=1)
+        rows = np.arange(len(omega))
+        values = omega[rows, :, component]  # (m, n)
+        crossing = changes[rows, :, component]
+        count = crossing.sum(axis=1)
+        dt = t[1:] - t[:-1]
+        times = t[:-1] - values[:, :-1] * dt / (values[:, 1:] - values[:, :-1])
+        order = np.cumsum(crossing, axis=1)
+        first = _crossing(times, order, crossing, 1)
+        second = _crossing(times, order, crossing, 2)
+        last = _crossing(times, order, crossing, count)
+        before_last = _crossing(times, order, crossing, count - 1)
+        period = (last + before_last - first - second) / (count - 2)
+    return np.where(count >= 3, period, np.nan)
+
+
+def _crossing(times: np.ndarray, order: np.ndarray, crossing: np.ndarray, k) -> np.ndarray:
+    """The time of each run's ``k``-th crossing (1-based; NaN where there is none)."""
+    hit = crossing & (order == np.reshape(k, (-1, 1)))
+    index = np.argmax(hit, axis=1)
+    return np.where(hit.any(axis=1), times[np.arange(len(times)), index], np.nan)
+
+
+def measured_period(t: np.ndarray, omega: np.ndarray) -> tuple[float | None, int, np.ndarray]:
+    """One run's :func:`measured_periods`, with the component and the crossings it used.
 
     Parameters
     ----------
@@ -97,10 +149,8 @@ def measured_period(t: np.ndarray, omega: np.ndarray) -> tuple[float | None, int
     """
     crossings = [zero_crossings(t, omega[:, k]) for k in range(3)]
     component = int(np.argmax([len(c) for c in crossings]))
-    chosen = crossings[component]
-    if len(chosen) < 3:
-        return None, component, chosen
-    return float(np.mean(chosen[2:] - chosen[:-2])), component, chosen
+    period = float(measured_periods(t, omega[None])[0])
+    return (None if np.isnan(period) else period), component, crossings[component]
 
 
 def flip_times(body: RigidBody, omega0, t_end: float) -> np.ndarray:
