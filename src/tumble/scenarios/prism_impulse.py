@@ -28,7 +28,7 @@ from numpy.typing import ArrayLike
 from tumble import _checks, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import Impulse, RigidBody, simulate
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import method_names
 from tumble.viz import rigid
 
@@ -156,16 +156,12 @@ def run(
         summary,
         {"trajectories": runs, "body": body},
         figures,
-        datasets=rigid_datasets(runs, body_mesh, shown),
         attrs=rigid_attrs(
             body, methods=list(methods), h=h, t_end=t_end, impulse=impulse.impulse.tolist()
         ),
-        animations=rigid_animations(
-            runs[shown],
-            body_mesh,
-            title=f"{title}, {shown}",
-            loads=(impulse,),
-        ),
+        **rigid_outputs(
+            runs, body_mesh, shown=shown, title=f"{title}, {shown}", loads=(impulse,)
+        ),  # fmt: skip
     )
 
 

@@ -53,7 +53,7 @@ from tumble.rigid import (
 )
 from tumble.rigid.initial import check_steps, initial_attitude
 from tumble.rigid.methods import METHODS, get_method
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios._base import rigid_attrs, rigid_outputs
 from tumble.scenarios._common import json_number
 from tumble.scenarios.bodies import Body
 from tumble.scenarios.schema import (
@@ -372,7 +372,6 @@ def run(
         summary=summary,
         data={"trajectory": trajectory, "body": rigid_body, "mesh": surface, "options": options},
         figures=_figures(trajectory, surface, title, summary["conserved"]),
-        datasets=rigid_datasets({options.method: trajectory}, surface, options.method),
         attrs=rigid_attrs(
             rigid_body,
             method=options.method,
@@ -383,7 +382,7 @@ def run(
             body_kind=options.body.label(),
             com=com.tolist(),
         ),
-        animations=rigid_animations(trajectory, surface, title=title, loads=tuple(forces)),
+        **rigid_outputs({options.method: trajectory}, surface, title=title, loads=tuple(forces)),
     )
 
 

@@ -23,7 +23,7 @@ from tumble import exact, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody
 from tumble.rigid import methods as rigid_methods
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import method_names, simulate_method
 from tumble.viz import rigid
 
@@ -95,9 +95,8 @@ def run(
         summary=summary,
         data={"trajectories": runs, "errors": errors},
         figures=_figures(runs, errors, title),
-        datasets=rigid_datasets(runs, mesh, shown),
         attrs=rigid_attrs(body, methods=list(methods), h=h, rtol=rtol, t_end=t_end),
-        animations=rigid_animations(runs[shown], mesh, title=f"{title}, {shown}"),
+        **rigid_outputs(runs, mesh, shown=shown, title=f"{title}, {shown}"),
     )
 
 

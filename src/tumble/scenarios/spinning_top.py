@@ -27,7 +27,7 @@ import numpy as np
 from tumble import _checks, mass, meshes, so3
 from tumble.io import ScenarioResult
 from tumble.rigid import Gravity, RigidBody, simulate
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import json_number, method_names
 
 NAME = "spinning-top"
@@ -158,11 +158,10 @@ def run(
         summary=summary,
         data={"trajectories": runs, "body": body, "tip": tip},
         figures=_figures(runs, np.degrees(bounds), title, summary, x_tip),
-        datasets=rigid_datasets(runs, mesh, shown),
         attrs=rigid_attrs(
             body, methods=list(methods), h=h, t_end=t_end, tilt=tilt, spin=spin, tip=tip.tolist()
         ),  # fmt: skip
-        animations=rigid_animations(runs[shown], mesh, title=f"{title}, {shown}"),
+        **rigid_outputs(runs, mesh, shown=shown, title=f"{title}, {shown}"),
     )
 
 

@@ -28,7 +28,7 @@ from tumble import _checks, exact, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, Trajectory, flip_event, simulate
 from tumble.rigid.forces import State
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios._base import rigid_attrs, rigid_outputs
 from tumble.viz import rigid
 
 NAME = "t-handle"
@@ -271,13 +271,13 @@ def run(
         summary=summary,
         data={"trajectories": runs, "body": body, "crossings": crossings},
         figures=_figures(summary, runs, crossings),
-        datasets=rigid_datasets(
-            {f"spin{k}": run for k, run in enumerate(runs, start=1)}, mesh, f"spin{shown + 1}"
-        ),
         attrs=rigid_attrs(body, method=method, h=h, rtol=rtol, t_end=t_end),
-        animations=rigid_animations(
-            runs[shown], mesh, title=f"{NAME} — {_label(summary['spins'][shown])}\n{setting}"
-        ),
+        **rigid_outputs(
+            {f"spin{k}": run for k, run in enumerate(runs, start=1)},
+            mesh,
+            shown=f"spin{shown + 1}",
+            title=f"{NAME} — {_label(summary['spins'][shown])}\n{setting}",
+        ),  # fmt: skip
     )
 
 

@@ -25,7 +25,7 @@ import numpy as np
 from tumble import exact, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, simulate
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import json_number, method_names
 from tumble.viz import rigid
 
@@ -102,13 +102,8 @@ def run(
         summary=summary,
         data={"trajectories": runs, "body": body},
         figures=_figures(body, runs, exact_R, title, omega0),
-        datasets=rigid_datasets(runs, mesh, shown),
         attrs=rigid_attrs(body, methods=list(methods), h=h, t_end=t_end, omega0=list(omega0)),
-        animations=rigid_animations(
-            runs[shown],
-            mesh,
-            title=f"{title}, {shown}",
-        ),
+        **rigid_outputs(runs, mesh, shown=shown, title=f"{title}, {shown}"),
     )
 
 
