@@ -21,6 +21,7 @@ import numpy as np
 from tumble import _checks, structural
 from tumble.io import FigureWriter, ScenarioResult
 from tumble.scenarios._common import json_number
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import structural as viz
 
 NAME = "beam"
@@ -28,6 +29,12 @@ SUMMARY = "Seed 003: steel cantilever under a step tip load, four time-stepping 
 
 BETA_L = np.array([1.87510406871196, 4.69409113297418, 7.85475743823761, 10.9955407348755])
 """The first roots of ``cos βL cosh βL = −1`` (clamped–free beam)."""
+
+OPTION_RULES = OptionRules(
+    positive=["length", "n_elements", "E", "rho", "width", "height", "steps_per_period",
+              "n_steps", "sweep_steps", "frame_every"],
+)  # fmt: skip
+"""What :func:`run`'s options must be beyond its signature (the tip load takes any sign)."""
 
 SWEEP_FACTORS = (0.25, 0.5, 0.9, 0.98, 1.02, 1.1, 2.0, 10.0, 100.0)
 """Sweep time steps, as multiples of the semi-implicit critical step."""

@@ -19,8 +19,8 @@ numbers as ``tumble run NAME``. The user's own body is the scenario ``"rigid-bod
 ``docs/scenario-files.md``.
 
 Options are checked by one pydantic model per scenario, declared as ``OPTIONS`` or derived
-from the signature of its ``run`` (:mod:`tumble.scenarios.option_models`, with the value
-rules :data:`POSITIVE` and :data:`METHOD_CHOICES`). The value types, the base of every
+from the signature of its ``run`` and the rules its module declares as ``OPTION_RULES``
+(:mod:`tumble.scenarios.option_models`). The value types, the base of every
 table (:class:`Section`) and the messages are in :mod:`tumble.scenarios.schema`; this module
 reads the file and checks it.
 
@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, ClassVar
 
 from tumble.scenarios import registry
-from tumble.scenarios.option_models import METHOD_CHOICES, POSITIVE, options_model
+from tumble.scenarios.option_models import options_model
 from tumble.scenarios.schema import Flag, PositiveInteger, Section, Text, short_repr, validate
 
 if TYPE_CHECKING:
@@ -336,8 +336,6 @@ def with_overrides(scenario: str, options: Mapping[str, Any], **overrides: Any) 
 
 
 __all__ = [
-    "METHOD_CHOICES",
-    "POSITIVE",
     "Outputs",
     "ScenarioFile",
     "Section",

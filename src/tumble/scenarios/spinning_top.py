@@ -29,11 +29,15 @@ from tumble.io import ScenarioResult
 from tumble.rigid import Gravity, RigidBody, simulate
 from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import json_number, method_names
+from tumble.scenarios.option_models import OptionRules
 
 NAME = "spinning-top"
 SUMMARY = "A heavy symmetric top on its tip: precession and nutation between the classical bounds."
 
 METHODS = ("yoshida4", "rkmk4")
+OPTION_RULES = OptionRules(positive=["t_end", "h", "density"])
+"""What :func:`run`'s options must be beyond its signature (the tilt and spin are checked by
+:func:`run`)."""
 """The methods compared by default: splitting on the exact flow, and RKMK4."""
 G = 9.81
 """Gravity (m/s², along −z)."""

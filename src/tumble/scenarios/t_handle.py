@@ -29,6 +29,7 @@ from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, Trajectory, flip_event, simulate
 from tumble.rigid.forces import State
 from tumble.scenarios._base import rigid_attrs, rigid_outputs
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import rigid
 
 NAME = "t-handle"
@@ -38,6 +39,8 @@ SUMMARY = (
 
 SPINS = ((1.0, 0.05, 0.0), (0.0, 1.0, 0.05), (0.05, 0.0, 1.0))
 """Seed 002's initial body angular velocities (rad/s)."""
+OPTION_RULES = OptionRules(positive=["h", "t_end", "rtol"], three_vectors=["spins"])
+"""What :func:`run`'s options must be beyond its signature: each spin is a 3-vector."""
 FLIP_METHOD, FLIP_RTOL = "rkmk-dopri5", 1e-10
 """How :func:`flip_times` integrates: the error it leaves in a flip time is about 1e-11 of
 the half period per flip (measured)."""

@@ -27,12 +27,17 @@ from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, simulate
 from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import json_number, method_names
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import rigid
 
 NAME = "torus-spin"
 SUMMARY = "Seed 000: a free torus spun at ω(0) = (1, 1, 1); rk4-matrix drifts off SO(3)."
 
 METHODS = ("rk4-matrix", "rk4-quat", "lie-euler", "rkmk4")
+OPTION_RULES = OptionRules(
+    positive=["t_end", "h", "major_radius", "minor_radius", "density"], three_vectors=["omega0"]
+)
+"""What :func:`run`'s options must be beyond its signature: ω₀ is a 3-vector (rad/s)."""
 """The methods compared by default."""
 OMEGA0 = (1.0, 1.0, 1.0)
 """Seed 000's angular velocity (rad/s), here the initial body-frame value."""
