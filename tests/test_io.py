@@ -279,3 +279,21 @@ def test_a_multi_run_root_lists_its_groups_and_how_to_open_them(tmp_path):
         assert "open_datatree" in root.attrs["comment"]
     with xr.open_dataset(tmp_path / "data.nc", engine="h5netcdf", group="spin2") as spin:
         assert spin.sizes["time"] == 101
+
+
+def test_write_figures_refuses_an_existing_file_unless_forced(tmp_path):
+    from tumble.io import write_figures
+
+    def writer(text):
+        return lambda path: path.write_text(text)
+
+    figures = [("a.txt", writer("one")), ("b.txt", writer("two"))]
+    paths = write_figures(tmp_path / "new", figures)
+    assert [p.read_text() for p in paths] == ["one", "two"]
+    (paths[1]).write_text("kept")
+    with pytest.raises(FileExistsError) as refused:
+        write_figures(tmp_path / "new", [("a.txt", writer("three")), ("b.txt", writer("x"))])
+    assert refused.value.filename == str(paths[0])
+    assert paths[0].read_text() == "one"  # nothing written when one file is refused
+    write_figures(tmp_path / "new", [("a.txt", writer("three"))], force=True)
+    assert paths[0].read_text() == "three" and paths[1].read_text() == "kept"

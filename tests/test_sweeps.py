@@ -18,8 +18,8 @@ import tumble
 from tumble.rigid.batch import FIXED_METHODS
 from tumble.scenarios import rigid_body
 from tumble.sweeps import make_plan
-from tumble.sweeps.members import SERIES, SUMMARY
 from tumble.sweeps.store import write_region, write_template
+from tumble.sweeps.variables import SERIES, SUMMARY
 
 EXAMPLES = Path(__file__).parents[1] / "examples"
 BODY = {"shape": "box", "extents": [0.3, 0.2, 0.1], "mass": 2.0}
@@ -331,10 +331,10 @@ def test_swept_attitude_under_gravity_equals_single_runs(client, tmp_path):
 
 
 def test_batched_periods_equal_the_scenario_measure():
-    """members.periods (telescoped, vectorised) is t_handle.measured_period to round-off."""
+    """t_handle.measured_periods (telescoped, vectorised) is measured_period of each run."""
     from tumble import RigidBody, mass, simulate_batch
     from tumble.scenarios.t_handle import measured_period
-    from tumble.sweeps.members import periods
+    from tumble.scenarios.t_handle import measured_periods as periods
 
     body = RigidBody.from_mass_properties(mass.t_handle())
     spins = [[1.0, 0.05, 0.0], [1.0, 0.01, 0.08], [0.05, 0.0, 1.0], [0.0, 1.0, 0.05]]

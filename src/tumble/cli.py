@@ -9,7 +9,6 @@ says which run stopped, when and why. Numerical warnings of the library stay off
 
 from __future__ import annotations
 
-import inspect
 import json
 import logging
 import warnings
@@ -171,37 +170,6 @@ def list_scenarios() -> None:
     console.print(table)
 
 
-def _apply(name: str, options: dict, **overrides: Any) -> dict:
-    """Put ``--method``, ``--h`` and ``--t-end`` into ``options`` where the scenario takes them."""
-    parameters = inspect.signature(scenarios.get(name).run).parameters
-    options = dict(options)
-    for option, value in overrides.items():
-        if value is None:
-            continue
-        if option == "method" and "method" not in parameters and "methods" in parameters:
-            options["methods"] = [value]
-        elif option in parameters:
-            options[option] = value
-        else:
-            flag = "--" + option.replace("_", "-")
-            raise ValueError(
-                f"{flag}={value!r} does not apply to scenario {name!r}; "
-                f"its options are {sorted(parameters)}"
-            )
-    return options
-
-
-def _scenario(target: str) -> tuple[str, dict, bool, str]:
-    """``(scenario, options, animation, folder name)`` for a built-in name or a TOML file."""
-    from tumble.scenarios import files
-
-    if target.endswith(".toml") or Path(target).is_file():
-        spec = files.read(target)
-        return spec.scenario, dict(spec.options), bool(spec.outputs.animation), Path(target).stem
-    scenarios.get(target)  # unknown names fail here, listing the known ones
-    return target, {}, True, target
-
-
 @app.command()
 def run(
     target: Annotated[
@@ -223,38 +191,21 @@ def run(
     from tumble.scenarios import files
 
     with _reported():
-        name, options, file_animation, default = _scenario(target)
-        if name == "rigid-body" and not options:
-            raise ValueError(
-                "scenario 'rigid-body' describes your own body: run it from a TOML file "
-                "(tumble run FILE.toml; see examples/t-handle-parts.toml)"
-            )
-        options = _apply(name, options, method=method, h=h, t_end=t_end)
-        options = files.check_options(name, options)
-        with _progress(f"running {name}") as note, warnings.catch_warnings():
+        chosen = files.read_target(target, method=method, h=h, t_end=t_end)
+        with _progress(f"running {chosen.scenario}") as note, warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)  # overflow, nan: said in words below
-            result = _run_scenario(name, options, None if target == name else target)
+            result = chosen.run()
             folder = _write(
-                result, out or Path("runs") / default, force, animation and file_animation, note,
-                mp4,
+                result, out or Path("runs") / chosen.folder, force,
+                animation and chosen.animation, note, mp4,
             )  # fmt: skip
-    _show_summary(name, result.summary, folder)
+    _show_summary(chosen.scenario, result.summary, folder)
     stopped = result.unfinished()
     if stopped:
         for where, message in stopped:
             errors.print(f"error: {where} did not reach its end:", style="bold red", end=" ")
             errors.print(message, markup=False, highlight=False, soft_wrap=True)
         raise typer.Exit(code=UNFINISHED)
-
-
-def _run_scenario(name: str, options: dict, source: str | None) -> ScenarioResult:
-    """Run ``name``; a bad value found only by the scenario names the file it came from."""
-    try:
-        return scenarios.get(name).run(**options)
-    except ValueError as error:
-        if source is None:
-            raise
-        raise ValueError(f"{source}: [options] {error}") from None
 
 
 @app.command()
@@ -350,35 +301,16 @@ def _mode_cell(radius: float, value: float) -> str:
 
 def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool) -> None:
     """``tumble stability --analyse``: the amplification picture and the per-mode tables."""
-    import numpy as np
-
-    from tumble import structural
-    from tumble.viz._figure import save
-    from tumble.viz.amplification import amplification_figure, comparison_figure
+    from tumble.io import write_figures
+    from tumble.scenarios import beam
 
     with _reported():
-        system = structural.cantilever(1.0, n_elements, 210e9, 7850.0, 0.01, 0.01, 1.0)
-        step = dt if dt is not None else 2 * np.pi / system.natural_frequencies(1)[0] / 20
-        table = structural.mode_table(system, step)
-        omega = 2 * np.pi * np.logspace(-2, 3, 241)
-        analyses = [structural.amplification(s, omega) for s in structural.SCHEMES.values()]
-    path = folder / "amplification.png"
-    if path.exists() and not force:
-        raise _fail(f"{path} exists; pass --force to overwrite it")
-    folder.mkdir(parents=True, exist_ok=True)
-    save(amplification_figure(analyses, title="amplification on ẍ + ω²x = 0 (SCHEMES' defaults)"),
-         path, dpi=110)  # fmt: skip
-    period = 2 * np.pi / table.omega[0]
-    with _reported():
-        runs = {name: structural.integrate(system, s, period / 100, n_steps=500, record_every=2)
-                for name, s in structural.SCHEMES.items()
-                if structural.critical_dt(system, s).dt > period / 100}  # fmt: skip
-        exact = structural.exact_response(system, next(iter(runs.values())).t)
-    title = (f"{n_elements}-element cantilever, 1 N step load from rest, Δt = T₁/100, "
-             "against exact_response")  # fmt: skip
-    save(comparison_figure(system, runs, exact, title=title), folder / "schemes_vs_exact.png",
-         dpi=110)  # fmt: skip
-
+        analysis = beam.analyse_steps(n_elements, dt)
+        try:
+            path, comparison = write_figures(folder, analysis.figures, force=force)
+        except FileExistsError as error:
+            raise _fail(f"{error.filename} exists; pass --force to overwrite it") from None
+    table, step = analysis.table, analysis.dt
     for name, values in (("algorithmic damping ratio ξ̄", table.damping_ratio),
                          ("period elongation (T̄ − T)/T", table.period_elongation)):  # fmt: skip
         grid = Table(title=f"{name}, cantilever with {n_elements} elements, Δt = {step:.4g} s "
@@ -394,7 +326,7 @@ def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool)
             frequency = f"{w:.0f}" if w >= 100 else f"{w:.4g}"
             grid.add_row(str(k + 1), frequency, f"{w * step:.3g}", *cells)
         console.print(grid)
-    console.print(f"plots: {path}, {folder / 'schemes_vs_exact.png'}", highlight=False)
+    console.print(f"plots: {path}, {comparison}", highlight=False)
 
 
 Grid = Annotated[
@@ -433,23 +365,18 @@ def sweep(
 ) -> None:
     """Run a scenario over a grid of options on Dask, into one Zarr store."""
     from tumble.sweeps import sweep as run_sweep
-    from tumble.sweeps.picture import draw_map, swept_dims
-    from tumble.sweeps.text import parse_values
+    from tumble.sweeps.picture import draw_map, map_variable
+    from tumble.sweeps.text import grid_from_arguments
 
     with _reported():
-        values = {}
-        for item in grid or []:
-            key, sign, text = item.partition("=")
-            if not sign:
-                raise ValueError(f"--grid {item!r}: must be PATH=VALUES, e.g. omega0.1=0:0.1:5")
-            values[key.strip()] = parse_values(key.strip(), text)
+        values = grid_from_arguments(grid or [])
         bar = Progress(TextColumn("sweep"), BarColumn(), TextColumn("{task.completed}/"
                        "{task.total} members"), TimeElapsedColumn(), console=console,
                        disable=not console.is_terminal)  # fmt: skip
         with bar:
             task = bar.add_task("members", total=None)
             dataset = run_sweep(
-                str(file), values or None, client=scheduler, store=out, chunk=chunk,
+                str(file), values, client=scheduler, store=out, chunk=chunk,
                 resume=resume, timeout=timeout,
                 progress=lambda done, total: bar.update(task, completed=done, total=total),
             )  # fmt: skip
@@ -462,12 +389,9 @@ def sweep(
             table.add_row("stopped (failed)", str(int((status < 0).sum())))
         table.add_row("wall time of the members", f"{float(dataset['wall_time'].sum()):.3g} s")
         console.print(table)
-        two = len(swept_dims(dataset)) == 2 and "flip_period" in dataset
-        name = draw or ("flip_period" if two else None)
-        if draw is None and name is not None and dataset[name].isnull().all():
-            console.print("no flip period measured (fewer than three crossings): no map; run "
-                          "longer, or choose another variable with --map")  # fmt: skip
-            name = None
+        name, note = map_variable(dataset, draw)
+        if note:
+            console.print(note)
         if name is not None:
             picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
             console.print(f"map: {picture}", highlight=False)
@@ -482,44 +406,10 @@ def view(
 ) -> None:
     """Write (if missing) and open the run's interactive viewer, view.html."""
     with _reported():
-        page = _viewer(run_dir)
+        page = scenarios.view_page(run_dir)
     console.print(f"viewer: {page}", highlight=False)
     if open_browser and not webbrowser.open(page.resolve().as_uri()):
         console.print("no web browser found; open the file above yourself")
-
-
-def _listed(run_dir: Path, name: str) -> bool:
-    """Whether the run's ``summary.json`` lists ``name`` (a file of this run, not a stale one)."""
-    try:
-        return name in json.loads((run_dir / "summary.json").read_text(encoding="utf-8"))["files"]
-    except (OSError, ValueError, KeyError, TypeError):
-        return False
-
-
-def _viewer(run_dir: Path) -> Path:
-    """The run's ``view.html``, drawn again from ``data.nc`` when it is not there."""
-    page = run_dir / "view.html"
-    if page.is_file() and _listed(run_dir, page.name):
-        return page
-    import trimesh
-
-    from tumble.io import atomic_write, load
-    from tumble.rigid import Trajectory
-    from tumble.viz.html import html_viewer
-
-    run = load(run_dir)
-    if "mesh" not in run.groups:
-        raise ValueError(
-            f"run_dir={str(run_dir)!r} holds no body mesh (scenario "
-            f"{run.attrs.get('scenario')!r}); the viewer shows rigid-body runs only"
-        )
-    mesh_data = run.dataset("mesh")
-    mesh = trimesh.Trimesh(mesh_data["vertices"].values, mesh_data["faces"].values, process=False)
-    shows = mesh_data.attrs["shows"]
-    trajectory = Trajectory.from_xarray(run.dataset(shows))
-    title = f"{run.attrs.get('scenario')} — {f'{shows}, ' if shows else ''}{trajectory.method}"
-    atomic_write(page, lambda tmp: html_viewer(trajectory, mesh, tmp, title=title))
-    return page
 
 
 @app.command("mass")

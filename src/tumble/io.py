@@ -27,9 +27,10 @@ True
 
 from __future__ import annotations
 
+import errno
 import json
 import logging
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from os import PathLike
 from pathlib import Path
@@ -267,6 +268,38 @@ def write_run_folder(
         files.append(DATA_FILE)
     write_json(out / SUMMARY_FILE, {**result.summary, "files": files})
     return out
+
+
+def write_figures(
+    out: str | Path, figures: Sequence[tuple[str, FigureWriter]], *, force: bool = False
+) -> list[Path]:
+    """Write each ``(name, writer)`` of ``figures`` into the folder ``out``, atomically.
+
+    Unlike :func:`write_run_folder`, only these files are written (no ``summary.json``, no
+    ``data.nc``), beside whatever the folder holds; the folder is created if missing.
+
+    Returns
+    -------
+    list of Path
+        The files, in the order of ``figures``.
+
+    Raises
+    ------
+    FileExistsError
+        If one of the files exists and ``force`` is False (its path is the error's
+        ``filename``); nothing is written then.
+    """
+    folder = Path(out)
+    paths = [folder / name for name, _ in figures]
+    for path in paths:
+        if path.exists() and not force:
+            raise FileExistsError(
+                errno.EEXIST, "exists; pass force=True to overwrite it", str(path)
+            )
+    folder.mkdir(parents=True, exist_ok=True)
+    for path, (_, writer) in zip(paths, figures, strict=True):
+        atomic_write(path, writer)
+    return paths
 
 
 def _forget_previous_run(out: Path) -> None:

@@ -459,3 +459,33 @@ def test_a_mesh_with_a_separate_inside_out_part_is_refused_with_the_key(tmp_path
         r"part and save the file again",
     ):
         read(path)
+
+
+@pytest.mark.parametrize("name", DERIVED)
+def test_every_option_rule_names_an_option_of_its_own_scenario(name):
+    from tumble.scenarios.option_models import rules
+
+    options = set(inspect.signature(scenarios.get(name).run).parameters)
+    assert rules(name).names() <= options, rules(name).names() - options
+
+
+@pytest.mark.parametrize("name", DERIVED)
+def test_a_scenario_declares_its_own_three_vector_options(name):
+    """THREE_VECTORS gathers the scenarios' rules: an option is a 3-vector where declared."""
+    from tumble.scenarios.option_models import rules
+
+    for parameter in inspect.signature(scenarios.get(name).run).parameters.values():
+        default = np.asarray(parameter.default if parameter.default is not None else [])
+        if default.dtype.kind == "f" and default.shape[-1:] == (3,):
+            assert parameter.name in rules(name).three_vectors, f"{name}: {parameter.name}"
+
+
+@pytest.mark.parametrize("name", DERIVED)
+def test_declared_positive_options_refuse_zero(name):
+    from tumble.scenarios.option_models import rules
+
+    model = options_model(name)
+    for option in sorted(rules(name).positive):
+        value = [0, 1] if "list" in str(model.model_fields[option].annotation) else 0
+        with pytest.raises(ValueError, match=rf"options.{option} = .*must be > 0"):
+            check_options(name, {option: value})

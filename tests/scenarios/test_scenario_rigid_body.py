@@ -214,3 +214,34 @@ def test_box_example_file_runs():
     summary = scenarios.get(scenario_file.scenario).run(**options).summary
     assert summary["loads"] == ["gravity", "impulse"]
     assert summary["status"] == 0
+
+
+def test_run_simulates_the_prepared_run_bit_for_bit():
+    options = {"body": BOX, "initial": {"omega0": [0.1, 3.0, 0.1], "euler_zyx": [0.1, 0.2, 0.3]},
+               "loads": [{"type": "gravity"}], "t_end": 1.0}  # fmt: skip
+    ready = rigid_body.prepare(rigid_body.OPTIONS.model_validate(options))
+    trajectory = rigid_body.run(**options).data["trajectory"]
+    again = ready.simulate()
+    assert np.array_equal(trajectory.R, again.R) and np.array_equal(trajectory.x, again.x)
+    np.testing.assert_array_equal(ready.start["R0"], so3.matrix_from_euler_zyx([0.1, 0.2, 0.3]))
+
+
+def test_prepared_start_puts_the_body_where_its_description_does():
+    off_centre = {**SPHERE, "center": [0.5, -0.25, 1.0]}
+    ready = rigid_body.prepare(rigid_body.OPTIONS.model_validate({"body": off_centre}))
+    assert ready.start["x0"].tolist() == [0.5, -0.25, 1.0] == ready.com.tolist()
+    assert ready.start["v0"] is None and ready.start["omega0"] is None
+
+
+@pytest.mark.parametrize(
+    ("changes", "batchable"),
+    [
+        ({}, True),
+        ({"loads": [{"type": "gravity"}, {"type": "torque", "torque": [0.0, 0.0, 1.0]}]}, True),
+        ({"method": "rkmk45", "h": None}, False),
+        ({"loads": [{"type": "impulse", "impulse": [0.0, 0.0, 1.0], "point": [0, 0, 0]}]}, False),
+    ],
+)
+def test_runs_batch_with_a_fixed_step_under_constant_loads(changes, batchable):
+    options = rigid_body.OPTIONS.model_validate({"body": BOX, **changes})
+    assert rigid_body.prepare(options).batchable is batchable

@@ -1,5 +1,6 @@
 """Each built-in scenario, run short, writes every file it promises, and reads back."""
 
+import dataclasses
 import json
 from pathlib import Path
 
@@ -90,3 +91,26 @@ def test_example_file_runs_and_writes_every_file(path, tmp_path):
     assert {p.name for p in tmp_path.iterdir()} == promised
     sizes = {name: (tmp_path / name).stat().st_size for name in promised - {"summary.json"}}
     assert min(sizes.values()) > 1000, sizes
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_view_draws_again_the_page_the_run_wrote(path, tmp_path):
+    """tumble view on a folder written without view.html: the run's own page, byte for byte
+    (the title, the shown run and the impulse arrows come back from data.nc's mesh group)."""
+    from tumble.scenarios import files
+
+    spec = files.read(path)
+    options = {**spec.options, **SHORT.get(spec.scenario, {})}
+    if spec.scenario == "rigid-body":
+        options.update(SHORTER)
+    result = scenarios.get(spec.scenario).run(**files.check_options(spec.scenario, options))
+    io.write_run_folder(dataclasses.replace(result, figures=[]), tmp_path, animation=False)
+    writers = dict(result.animations)
+    if "view.html" not in writers:  # no moving body to show
+        with pytest.raises(ValueError, match="holds no body mesh"):
+            scenarios.view_page(tmp_path)
+        return
+    writers["view.html"](tmp_path / "written.html")
+    page = scenarios.view_page(tmp_path)
+    assert page == tmp_path / "view.html"
+    assert page.read_bytes() == (tmp_path / "written.html").read_bytes()

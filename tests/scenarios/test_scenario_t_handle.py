@@ -135,3 +135,33 @@ def test_a_diverged_spin_still_writes_its_run_folder_without_warnings(diverged, 
     folder = write_run_folder(diverged, tmp_path / "run")  # filterwarnings = error
     assert json.loads((folder / "summary.json").read_text())["spins"][0]["status"] == -1
     assert (folder / "drift.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_measured_periods_are_the_mean_of_every_other_crossing_interval():
+    """The telescoped, vectorised period equals the mean of c[k + 2] − c[k] to round-off."""
+    from tumble.scenarios.t_handle import measured_periods
+
+    t = np.linspace(0.0, 40.0, 4001)
+    rates = [0.7, 1.3, 2.9]
+    omega = np.stack([np.stack([np.cos(w * t), np.sin(w * t), 0.1 + 0 * t], axis=1)
+                      for w in rates])  # fmt: skip
+    omega[2, :, 0] += 0.3 * np.sin(5.1 * t)  # uneven crossings: the mean is not one interval
+    found = measured_periods(t, omega)
+    for k in range(len(rates)):
+        crossings = zero_crossings(t, omega[k, :, 0])
+        assert found[k] == pytest.approx(np.mean(crossings[2:] - crossings[:-2]), rel=1e-13)
+    assert found[0] == pytest.approx(2 * np.pi / rates[0], rel=1e-4)  # linear interpolation
+
+
+def test_measured_periods_are_nan_for_fewer_than_three_crossings_and_after_a_stop():
+    from tumble.scenarios.t_handle import measured_periods
+
+    t = np.linspace(0.0, 3.0, 301)
+    short = np.stack([np.cos(t), np.sin(t), np.ones_like(t)], axis=1)[None]
+    assert np.isnan(measured_periods(t, short)).all()
+    t = np.linspace(0.0, 30.0, 3001)
+    spin = np.stack([np.cos(t), np.sin(t), np.ones_like(t)], axis=1)
+    stopped = spin.copy()
+    stopped[1000:] = np.nan  # 10 s: three crossings of cos t (1.6, 4.7, 7.9 s) before
+    found = measured_periods(t, np.stack([spin, stopped]))
+    assert found == pytest.approx([2 * np.pi, 2 * np.pi], rel=1e-4)

@@ -17,16 +17,16 @@ from tumble.report_card.cost import warm_cost
 from tumble.report_card.measure import (
     Invariants,
     Order,
-    Sweep,
+    Study,
     adaptive_order,
     contradictions,
     error_at,
     invariants,
     measured_order,
-    sweep,
+    study_row,
 )
 from tumble.report_card.peers import Row
-from tumble.report_card.problems import Problem
+from tumble.report_card.problems import CardProblem
 from tumble.report_card.structural import StructuralRow
 
 log = logging.getLogger(__name__)
@@ -38,7 +38,7 @@ class RowResult:
 
     row: Row
     order: Order
-    sweeps: dict[str, Sweep]
+    sweeps: dict[str, Study]
     errors: dict[str, float]  # problem -> error at T at the standard setting
     free: Invariants
     forced: Invariants | None
@@ -72,15 +72,15 @@ class ReportCard:
         return f"tumble report card{' (quick)' if self.quick else ''}"
 
 
-def measure_row(row: Row, tests: list[Problem], references: dict[str, np.ndarray],
+def measure_row(row: Row, tests: list[CardProblem], references: dict[str, np.ndarray],
                 long_t: float, repeat: int, first: dict[str, float]) -> RowResult:  # fmt: skip
     """Measure ``row`` on ``tests`` (P1 first, the forced body last) against ``references``:
     its sweeps, order, errors at T, long-run invariants, cost and contradictions."""
     log.info("report card: measuring %s", row.name)
     p1, forced = tests[0], tests[-1]
-    free_sweep = sweep(row, p1, references[p1.name], repeat)
+    free_sweep = study_row(row, p1, references[p1.name], repeat)
     assert free_sweep is not None
-    forced_sweep = sweep(row, forced, references[forced.name], repeat)
+    forced_sweep = study_row(row, forced, references[forced.name], repeat)
     sweeps = {data.problem: data for data in (free_sweep, forced_sweep) if data is not None}
     if row.adaptive:  # the order of the formula it propagates, at fixed steps
         order = adaptive_order(row, free_sweep, references[p1.name], p1)

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from tumble import exact
 from tumble.report_card.measure import sampled, standard_setting
 from tumble.report_card.peers import Row, run_row
-from tumble.report_card.problems import P1_L0, Problem, p1_body
+from tumble.report_card.problems import P1_L0, CardProblem, p1_body
 from tumble.rigid import METHODS, simulate
 
 log = logging.getLogger(__name__)
@@ -76,7 +76,7 @@ def _fresh_process(names: Sequence[str], cache: str | None) -> dict[str, float]:
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def warm_cost(row: Row, problem: Problem, repeat: int) -> float:
+def warm_cost(row: Row, problem: CardProblem, repeat: int) -> float:
     """µs per accepted step at the standard setting on ``problem``, best of ``repeat``, after
     a warm-up run of 0.1 s."""
     setting = standard_setting(row)

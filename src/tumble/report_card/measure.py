@@ -31,7 +31,7 @@ import numpy as np
 
 from tumble import exact
 from tumble.report_card.peers import Row, Sampled, fixed_step_end, run_row
-from tumble.report_card.problems import Problem, attitude_error
+from tumble.report_card.problems import CardProblem, attitude_error
 
 ORDER_TOLERANCE = 0.3
 """A measured order agrees with the declared one within this (the slope of a least-squares
@@ -74,8 +74,9 @@ the dipole: 0.38 over [100, 1000] s, 0.13 over [10³, 10⁴] s, at 6e-5 both tim
 
 
 @dataclass
-class Sweep:
-    """One row's runs over its settings on one problem: the work–precision points.
+class Study:
+    """One row's runs over its settings on one problem (:func:`tumble.exact.study`'s trials):
+    the work–precision points. (Not :func:`tumble.sweep`, which runs a scenario over a grid.)
 
     ``mean_step`` is h for a fixed-step row, T / accepted steps for an adaptive one."""
 
@@ -107,7 +108,7 @@ def standard_setting(row: Row) -> float:
     return STANDARD_RTOL if row.adaptive else STANDARD_H
 
 
-def sampled(row: Row, problem: Problem, setting: float, **options) -> Sampled:
+def sampled(row: Row, problem: CardProblem, setting: float, **options) -> Sampled:
     """:func:`~tumble.report_card.peers.run_row` of a row that takes the problem's loads."""
     run = run_row(row, problem, setting, **options)
     assert run is not None, f"{row.name} takes no loads: {problem.name} is not its problem"
@@ -119,7 +120,7 @@ def against(R_ref: np.ndarray):
     return lambda run: attitude_error(run.R_end, R_ref) if run.ok else math.inf
 
 
-def sweep(row: Row, problem: Problem, R_ref: np.ndarray, repeat: int = 1) -> Sweep | None:
+def study_row(row: Row, problem: CardProblem, R_ref: np.ndarray, repeat: int = 1) -> Study | None:
     """Run ``row`` over :data:`STEP_COUNTS` (or :data:`TOLERANCES`) on ``problem``; each
     run's time is the best of ``repeat``, after one warm-up run (numba's dispatch, the first
     call's imports)."""
@@ -135,7 +136,7 @@ def sweep(row: Row, problem: Problem, R_ref: np.ndarray, repeat: int = 1) -> Swe
         warm_up=lambda: run_row(row, problem, settings[0], t_end=warm_t),
         seconds=lambda run: run.seconds,
     )
-    out = Sweep(problem.name)
+    out = Study(problem.name)
     for trial in trials:
         run = trial.result
         out.settings.append(trial.setting)
@@ -154,7 +155,7 @@ def _energy_error(run: Sampled) -> float:
     return energy if math.isfinite(energy) else math.inf
 
 
-def error_at(row: Row, problem: Problem, R_ref: np.ndarray) -> float:
+def error_at(row: Row, problem: CardProblem, R_ref: np.ndarray) -> float:
     """``‖R(T) − R_ref(T)‖_F`` at :func:`standard_setting` (NaN: the row takes no loads and
     the problem has some)."""
     if problem.forced and not row.takes_loads:
@@ -164,7 +165,7 @@ def error_at(row: Row, problem: Problem, R_ref: np.ndarray) -> float:
     return trial.error
 
 
-def _fit(row: Row, data: Sweep, window: tuple[float, float]) -> Order | None:
+def _fit(row: Row, data: Study, window: tuple[float, float]) -> Order | None:
     """:func:`tumble.exact.fit_order` of e against h̄ through the :data:`FIT_POINTS` finest
     errors inside ``window``, with the verdict; None when fewer than three are."""
     fit = exact.fit_order(data.mean_step, data.error, window=window, finest=FIT_POINTS,
@@ -175,7 +176,7 @@ def _fit(row: Row, data: Sweep, window: tuple[float, float]) -> Order | None:
     return Order(fit.order, fit.h_min, fit.h_max, fit.points, data.problem, verdict)
 
 
-def fixed_step_sweep(row: Row, problem: Problem, R_ref: np.ndarray) -> Sweep:
+def fixed_step_study(row: Row, problem: CardProblem, R_ref: np.ndarray) -> Study:
     """An adaptive row's errors at the fixed steps of :data:`STEP_COUNTS` (no timing), up to
     the second error at round-off (finer steps add nothing to the fit)."""
 
@@ -188,7 +189,7 @@ def fixed_step_sweep(row: Row, problem: Problem, R_ref: np.ndarray) -> Sweep:
         lambda R: attitude_error(R, R_ref),
         until=at_round_off,
     )
-    out = Sweep(problem.name)
+    out = Study(problem.name)
     for trial, n in zip(trials, STEP_COUNTS, strict=False):
         out.settings.append(trial.setting)
         out.mean_step.append(trial.setting)
@@ -197,7 +198,7 @@ def fixed_step_sweep(row: Row, problem: Problem, R_ref: np.ndarray) -> Sweep:
     return out
 
 
-def measured_order(row: Row, free: Sweep, forced: Sweep | None) -> Order:
+def measured_order(row: Row, free: Study, forced: Study | None) -> Order:
     """The order on P1, else on the forced body; an exact method at round-off on P1 is
     ``exact``; a row with no fit anywhere is ``no fit`` (a contradiction if it declares a
     finite order)."""
@@ -214,10 +215,10 @@ def measured_order(row: Row, free: Sweep, forced: Sweep | None) -> Order:
     return Order(math.nan, math.nan, math.nan, 0, free.problem, "contradicts")
 
 
-def adaptive_order(row: Row, free: Sweep, R_ref: np.ndarray, problem: Problem) -> Order:
+def adaptive_order(row: Row, free: Study, R_ref: np.ndarray, problem: CardProblem) -> Order:
     """An adaptive row's order: that of the formula it propagates, at fixed steps on
     ``problem``, with the slope of its tolerance sweep ``free`` against h̄ beside."""
-    order = measured_order(row, fixed_step_sweep(row, problem, R_ref), None)
+    order = measured_order(row, fixed_step_study(row, problem, R_ref), None)
     through_controller = _fit(row, free, ASYMPTOTIC)
     if through_controller is not None:
         order.against_mean_step = through_controller.measured
@@ -272,7 +273,7 @@ def growth_law(t: np.ndarray, energy: np.ndarray) -> tuple[float, float, str]:
     return slope, largest, verdict
 
 
-def invariants(row: Row, problem: Problem, t_end: float) -> Invariants | None:
+def invariants(row: Row, problem: CardProblem, t_end: float) -> Invariants | None:
     """Run ``row`` for ``t_end`` on ``problem`` at :data:`LONG_H` (:data:`LONG_RTOL`)."""
     run = run_row(row, problem, LONG_RTOL if row.adaptive else LONG_H, t_end=t_end,
                   samples=LONG_SAMPLES)  # fmt: skip

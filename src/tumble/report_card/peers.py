@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from tumble import _checks, so3
-from tumble.report_card.problems import Problem, rhs, y0
+from tumble.report_card.problems import CardProblem, rhs, y0
 from tumble.rigid import METHODS, simulate
 from tumble.rigid.methods import Method
 
@@ -105,7 +105,7 @@ class Sampled:
     ok: bool = True
 
 
-def _tumble_run(row: Row, problem: Problem, setting: float, t_end: float, samples: int):
+def _tumble_run(row: Row, problem: CardProblem, setting: float, t_end: float, samples: int):
     tolerance = setting if row.adaptive else None
     n_guess = samples if row.adaptive else max(1, round(t_end / setting))
     record = max(1, n_guess // samples) if samples else 2**62
@@ -125,7 +125,7 @@ def _tumble_run(row: Row, problem: Problem, setting: float, t_end: float, sample
                    run.n_steps, seconds, run.success and math.isfinite(orthogonality))  # fmt: skip
 
 
-def _peer_energy(problem: Problem, omega: np.ndarray, R: np.ndarray) -> np.ndarray:
+def _peer_energy(problem: CardProblem, omega: np.ndarray, R: np.ndarray) -> np.ndarray:
     inertia = problem.body.inertia.diagonal()
     kinetic = 0.5 * np.einsum("ni,ni->n", omega, omega * inertia)
     if problem.dipole is None:
@@ -133,7 +133,7 @@ def _peer_energy(problem: Problem, omega: np.ndarray, R: np.ndarray) -> np.ndarr
     return kinetic - np.einsum("nij,j,i->n", R, problem.dipole.moment, problem.dipole.field)
 
 
-def _scipy_run(method: str, problem: Problem, rtol: float, t_end: float) -> Sampled:
+def _scipy_run(method: str, problem: CardProblem, rtol: float, t_end: float) -> Sampled:
     """solve_ivp on :func:`~tumble.report_card.problems.rhs`; its samples are its accepted
     steps."""
     from scipy.integrate import solve_ivp
@@ -152,7 +152,7 @@ def _scipy_run(method: str, problem: Problem, rtol: float, t_end: float) -> Samp
                    int(solution.t.size - 1), seconds, bool(solution.success))  # fmt: skip
 
 
-def _mujoco_model(problem: Problem, integrator: str, h: float):
+def _mujoco_model(problem: CardProblem, integrator: str, h: float):
     """One free-joint body, gravity off; the inertia set after compiling (MuJoCo's compiler
     refuses P1's, which breaks the triangle inequality), as in benchmarks/bench_rigid.py."""
     import mujoco
@@ -167,7 +167,7 @@ def _mujoco_model(problem: Problem, integrator: str, h: float):
     return model
 
 
-def _mujoco_run(integrator: str, problem: Problem, h: float, t_end: float,
+def _mujoco_run(integrator: str, problem: CardProblem, h: float, t_end: float,
                 samples: int) -> Sampled:  # fmt: skip
     import mujoco
 
@@ -199,7 +199,7 @@ def _mujoco_run(integrator: str, problem: Problem, h: float, t_end: float,
                    not data.warning[bad].number)  # fmt: skip
 
 
-def run_row(row: Row, problem: Problem, setting: float, *, t_end: float | None = None,
+def run_row(row: Row, problem: CardProblem, setting: float, *, t_end: float | None = None,
             samples: int = 0) -> Sampled | None:  # fmt: skip
     """Run ``row`` on ``problem`` with ``setting`` (h, or rtol), keeping about
     ``samples`` samples (0: only the ends). None when the row takes no loads and the problem
@@ -215,7 +215,7 @@ def run_row(row: Row, problem: Problem, setting: float, *, t_end: float | None =
         return _mujoco_run(row.name.split()[-1], problem, setting, t_end, samples)
 
 
-def fixed_step_end(row: Row, problem: Problem, h: float) -> np.ndarray:
+def fixed_step_end(row: Row, problem: CardProblem, h: float) -> np.ndarray:
     """R(T) of an adaptive row's formula stepped at a fixed ``h``, without its controller.
 
     A tumble method: its own stepper (what ``simulate`` builds, :func:`_fixed_step_stepper`)
@@ -239,7 +239,7 @@ def fixed_step_end(row: Row, problem: Problem, h: float) -> np.ndarray:
     return out.records[0][-1]
 
 
-def _fixed_step_stepper(row: Row, problem: Problem):
+def _fixed_step_stepper(row: Row, problem: CardProblem):
     """The stepper ``simulate`` builds for ``row`` on ``problem`` (compiled where the loads
     allow), and its start.
 

@@ -36,8 +36,8 @@ REFERENCE_RTOL = 1e-13
 
 
 @dataclass(frozen=True)
-class Problem:
-    """One test problem: a body, its start (R₀ = I, ω₀ body frame), T and loads.
+class CardProblem:
+    """One problem of the report card: a body, its start (R₀ = I, ω₀ body frame), T and loads.
 
     ``dipole`` is None for a free body (exact reference) or the magnetic dipole.
     """
@@ -61,24 +61,24 @@ def p1_body() -> RigidBody:
     return RigidBody(1.0, P1_INERTIA, allow_unphysical=True)
 
 
-def problems() -> list[Problem]:
+def problems() -> list[CardProblem]:
     """P1, the T-handle's three spins, the near-separatrix spin and the forced body."""
     p1 = p1_body()
     p1_omega = P1_L0 / P1_INERTIA
     handle = RigidBody.from_mass_properties(mass.t_handle())
     spins = [
-        Problem(f"T-handle ω₀={tuple(spin)}", handle, np.array(spin, float), PROBLEM_T)
+        CardProblem(f"T-handle ω₀={tuple(spin)}", handle, np.array(spin, float), PROBLEM_T)
         for spin in t_handle.SPINS
     ]
     return [
-        Problem("P1", p1, p1_omega, SWEEP_T),
+        CardProblem("P1", p1, p1_omega, SWEEP_T),
         *spins,
-        Problem("separatrix", handle, np.array(SEPARATRIX_SPIN), PROBLEM_T),
-        Problem("forced", p1, p1_omega, SWEEP_T, DIPOLE),
+        CardProblem("separatrix", handle, np.array(SEPARATRIX_SPIN), PROBLEM_T),
+        CardProblem("forced", p1, p1_omega, SWEEP_T, DIPOLE),
     ]
 
 
-def rhs(problem: Problem) -> Callable[[float, np.ndarray], np.ndarray]:
+def rhs(problem: CardProblem) -> Callable[[float, np.ndarray], np.ndarray]:
     """Euler's equations and ``q̇ = ½ q ⊗ (0, ω)`` for ``y = (ω, q)`` (the peers' way), with
     the dipole's body torque ``μ × (Rᵀ B)``."""
     A, B, C = problem.body.inertia.diagonal()
@@ -106,12 +106,12 @@ def rhs(problem: Problem) -> Callable[[float, np.ndarray], np.ndarray]:
     return f
 
 
-def y0(problem: Problem) -> np.ndarray:
+def y0(problem: CardProblem) -> np.ndarray:
     """``y₀ = (ω₀, q₀ = 1)`` of :func:`rhs`."""
     return np.concatenate([problem.omega0, [1.0, 0.0, 0.0, 0.0]])
 
 
-def reference(problem: Problem, t_end: float | None = None) -> np.ndarray:
+def reference(problem: CardProblem, t_end: float | None = None) -> np.ndarray:
     """R(T): exact for a free body, scipy DOP853 at rtol = atol = 1e-13 for the forced one."""
     from scipy.integrate import solve_ivp
 

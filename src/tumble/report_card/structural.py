@@ -45,9 +45,9 @@ def structural_rows(quick: bool) -> tuple[list[StructuralRow], dict]:
     the order the scheme declares (its ``order``).
     """
     from tumble import structural
+    from tumble.scenarios.beam import steel_cantilever
 
-    beam = structural.cantilever(1.0, 4, E=210e9, rho=7850, width=0.01, height=0.01,
-                                 tip_load=1.0)  # fmt: skip
+    beam = steel_cantilever(4)
     omega1 = float(beam.natural_frequencies(1)[0]) * 2 * math.pi
     period = 2 * math.pi / omega1
     setup = {"omega1": omega1, "period": period,

@@ -11,14 +11,17 @@ beam every 10 steps of the midpoint run as frames for an animation.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from tumble import _checks, structural
-from tumble.io import ScenarioResult
+from tumble.io import FigureWriter, ScenarioResult
 from tumble.scenarios._common import json_number
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import structural as viz
 
 NAME = "beam"
@@ -27,19 +30,46 @@ SUMMARY = "Seed 003: steel cantilever under a step tip load, four time-stepping 
 BETA_L = np.array([1.87510406871196, 4.69409113297418, 7.85475743823761, 10.9955407348755])
 """The first roots of ``cos βL cosh βL = −1`` (clamped–free beam)."""
 
+OPTION_RULES = OptionRules(
+    positive=["length", "n_elements", "E", "rho", "width", "height", "steps_per_period",
+              "n_steps", "sweep_steps", "frame_every"],
+)  # fmt: skip
+"""What :func:`run`'s options must be beyond its signature (the tip load takes any sign)."""
+
 SWEEP_FACTORS = (0.25, 0.5, 0.9, 0.98, 1.02, 1.1, 2.0, 10.0, 100.0)
 """Sweep time steps, as multiples of the semi-implicit critical step."""
+
+STEEL = {"length": 1.0, "E": 210e9, "rho": 7850.0, "width": 0.01, "height": 0.01, "tip_load": 1.0}
+"""Seed 003's cantilever (the defaults of :func:`run`): 1 m long [m], E = 210 GPa [Pa],
+ρ = 7850 kg/m³, a 1 cm × 1 cm section [m], a 1 N step load at the tip [N]."""
+
+
+def steel_cantilever(n_elements: int = 20) -> structural.LinearSystem:
+    """Seed 003's steel cantilever (:data:`STEEL`) in ``n_elements`` Euler–Bernoulli elements.
+
+    The one beam of ``tumble run beam`` (its defaults), ``tumble stability`` (with and
+    without ``--analyse``) and the report card's structural table
+    (:func:`tumble.report_card.structural_rows`, 4 elements).
+
+    Examples
+    --------
+    >>> beam = steel_cantilever(8)
+    >>> beam.n_dofs, round(float(beam.natural_frequencies(1)[0]), 2)  # ω₁ [rad/s]
+    (16, 52.5)
+    """
+    return structural.cantilever(STEEL["length"], n_elements, STEEL["E"], STEEL["rho"],
+                                 STEEL["width"], STEEL["height"], STEEL["tip_load"])  # fmt: skip
 
 
 def run(
     *,
-    length: float = 1.0,
+    length: float = STEEL["length"],
     n_elements: int = 20,
-    E: float = 210e9,
-    rho: float = 7850.0,
-    width: float = 0.01,
-    height: float = 0.01,
-    tip_load: float = 1.0,
+    E: float = STEEL["E"],
+    rho: float = STEEL["rho"],
+    width: float = STEEL["width"],
+    height: float = STEEL["height"],
+    tip_load: float = STEEL["tip_load"],
     steps_per_period: int = 200,
     n_steps: int = 2000,
     sweep_steps: int = 1000,
@@ -51,7 +81,7 @@ def run(
     ----------
     length, n_elements, E, rho, width, height, tip_load
         The cantilever (:func:`tumble.structural.cantilever`): [m], –, [Pa], [kg/m³],
-        [m], [m], [N].
+        [m], [m], [N]; by default :func:`steel_cantilever`'s.
     steps_per_period : int
         Δt = T₁ / steps_per_period for the four scheme runs.
     n_steps : int
@@ -262,7 +292,7 @@ def stability(
         raise _checks.fail(
             "schemes", schemes, f"at least one of {', '.join(map(repr, structural.SCHEMES))}"
         )
-    beam = structural.cantilever(1.0, n_elements, 210e9, 7850.0, 0.01, 0.01, 1.0)
+    beam = steel_cantilever(n_elements)
     critical = structural.critical_dt(beam, "semi-implicit")
     dts = critical.dt * np.asarray(factors, dtype=float)
     sweeps = [structural.stability_sweep(beam, s, dts, sweep_steps) for s in schemes]
@@ -304,3 +334,98 @@ def _sweep_dataset(sweeps):
         {"energy_growth": (("scheme", "dt"), growth, {"units": "1"})},
         coords={"scheme": [s.scheme for s in sweeps], "dt": ("dt", sweeps[0].dt, {"units": "s"})},
     )
+
+
+# --- the time-step analyser (``tumble stability --analyse``) ----------------------------------
+
+ANALYSIS_OMEGA = 2 * np.pi * np.logspace(-2, 3, 241)
+"""The frequencies (rad/s) of the amplification picture: Δt/T from 10⁻² to 10³ at Δt = 1 s."""
+COMPARISON_STEPS = 500
+"""Steps of each scheme's run against the exact response, at Δt = T₁/100 (five periods)."""
+
+
+@dataclass(frozen=True)
+class StepAnalysis:
+    """What :func:`analyse_steps` finds: the beam's modes under each scheme, and the pictures.
+
+    Attributes
+    ----------
+    system : tumble.structural.LinearSystem
+        The cantilever (:func:`steel_cantilever`).
+    n_elements : int
+        Its elements.
+    dt : float
+        The step of the mode table [s].
+    table : tumble.structural.ModeTable
+        Each mode under each scheme at ``dt``: ω, spectral radius, damping, period error.
+    figures : list of (str, callable)
+        ``amplification.png`` and ``schemes_vs_exact.png`` with their writers
+        (:func:`tumble.io.write_figures` writes them).
+    """
+
+    system: structural.LinearSystem
+    n_elements: int
+    dt: float
+    table: structural.ModeTable
+    figures: list[tuple[str, FigureWriter]]
+
+
+def analyse_steps(n_elements: int = 20, dt: float | None = None) -> StepAnalysis:
+    """The time-step analyser on :func:`steel_cantilever`: pure (no files, no printing).
+
+    Every scheme of :data:`tumble.structural.SCHEMES` with its defaults: its amplification
+    on ẍ + ω²x = 0 against Δt/T (:func:`tumble.structural.amplification`), the beam's modes
+    under it at ``dt`` (:func:`tumble.structural.mode_table`), and its run from rest under
+    the tip load at Δt = T₁/100 against :func:`tumble.structural.exact_response` (schemes
+    whose critical step is below T₁/100 are left out).
+
+    Parameters
+    ----------
+    n_elements : int
+        Beam elements.
+    dt : float, optional
+        Step of the mode table [s]; default T₁/20.
+
+    Returns
+    -------
+    StepAnalysis
+
+    Raises
+    ------
+    ValueError
+        For a ``dt`` that is not finite and > 0.
+
+    Examples
+    --------
+    >>> analysis = analyse_steps(2, dt=1e-3)
+    >>> [name for name, _ in analysis.figures], len(analysis.table.omega)
+    (['amplification.png', 'schemes_vs_exact.png'], 4)
+    """
+    from tumble.viz._figure import save
+    from tumble.viz.amplification import amplification_figure, comparison_figure
+
+    system = steel_cantilever(n_elements)
+    step = dt if dt is not None else 2 * np.pi / system.natural_frequencies(1)[0] / 20
+    table = structural.mode_table(system, step)
+    analyses = [structural.amplification(s, ANALYSIS_OMEGA) for s in structural.SCHEMES.values()]
+    period = 2 * np.pi / table.omega[0]
+    runs = {name: structural.integrate(system, s, period / 100, n_steps=COMPARISON_STEPS,
+                                       record_every=2)
+            for name, s in structural.SCHEMES.items()
+            if structural.critical_dt(system, s).dt > period / 100}  # fmt: skip
+    exact = structural.exact_response(system, next(iter(runs.values())).t)
+    amplification_title = "amplification on ẍ + ω²x = 0 (SCHEMES' defaults)"
+    comparison_title = (f"{n_elements}-element cantilever, 1 N step load from rest, "
+                        "Δt = T₁/100, against exact_response")  # fmt: skip
+
+    def amplification(path: Path) -> None:
+        save(amplification_figure(analyses, title=amplification_title), path, dpi=110)
+
+    def comparison(path: Path) -> None:
+        save(comparison_figure(system, runs, exact, title=comparison_title), path, dpi=110)
+
+    figures: list[tuple[str, FigureWriter]] = [
+        ("amplification.png", amplification),
+        ("schemes_vs_exact.png", comparison),
+    ]
+    return StepAnalysis(system, n_elements, step, table, figures)

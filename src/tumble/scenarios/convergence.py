@@ -34,6 +34,7 @@ from tumble import _checks, exact
 from tumble.io import ScenarioResult
 from tumble.rigid import METHODS, RigidBody, Trajectory, simulate
 from tumble.scenarios._common import fixed_step_methods, method_names
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import rigid
 
 NAME = "convergence"
@@ -55,6 +56,13 @@ L0 = (float(np.cos(1.1)), 0.0, float(np.sin(1.1)))
 STEP_COUNTS = (200, 400, 800, 1600)
 """Steps over [0, T] by default: h = T/200 … T/1600, inside every method's asymptotic range
 and above round-off for the fourth-order ones."""
+OPTION_RULES = OptionRules(
+    positive=["t_end", "step_counts"],
+    min_distinct={"step_counts": 2},
+    methods=fixed_step_methods(),
+)
+"""What :func:`run`'s options must be: two distinct step counts make a slope; a method
+with an order in h (:func:`~tumble.scenarios._common.fixed_step_methods`)."""
 ROUND_OFF_FLOOR = 1e-13
 """Errors at or below this are round-off, not truncation error, and are left out of the fit.
 

@@ -19,8 +19,8 @@ numbers as ``tumble run NAME``. The user's own body is the scenario ``"rigid-bod
 ``docs/scenario-files.md``.
 
 Options are checked by one pydantic model per scenario, declared as ``OPTIONS`` or derived
-from the signature of its ``run`` (:mod:`tumble.scenarios.option_models`, with the value
-rules :data:`POSITIVE` and :data:`METHOD_CHOICES`). The value types, the base of every
+from the signature of its ``run`` and the rules its module declares as ``OPTION_RULES``
+(:mod:`tumble.scenarios.option_models`). The value types, the base of every
 table (:class:`Section`) and the messages are in :mod:`tumble.scenarios.schema`; this module
 reads the file and checks it.
 
@@ -39,14 +39,19 @@ ValueError: options.h = -0.01: must be > 0
 
 from __future__ import annotations
 
+import inspect
 import tomllib
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar
 
-from tumble.scenarios.option_models import METHOD_CHOICES, POSITIVE, options_model
+from tumble.scenarios import registry
+from tumble.scenarios.option_models import options_model
 from tumble.scenarios.schema import Flag, PositiveInteger, Section, Text, short_repr, validate
+
+if TYPE_CHECKING:
+    from tumble.io import ScenarioResult
 
 
 def check_options(
@@ -213,15 +218,133 @@ def read(path: str | Path) -> ScenarioFile:
     )
 
 
+# ---------------------------------------------------------------------------------------
+# What `tumble run NAME|FILE.toml` runs.
+
+
+@dataclass(frozen=True)
+class Target:
+    """A scenario to run, from a built-in's name or a file, its options checked.
+
+    Attributes
+    ----------
+    scenario : str
+        The scenario's name.
+    options : dict
+        Its checked options (:func:`check_options`), the overrides applied.
+    animation : bool
+        The file's ``[outputs].animation`` (True for a built-in's name).
+    folder : str
+        The run folder's default name: the file's stem, or the scenario's name.
+    source : str or None
+        The file as given; None for a built-in's name.
+    """
+
+    scenario: str
+    options: dict[str, Any]
+    animation: bool
+    folder: str
+    source: str | None
+
+    def run(self) -> ScenarioResult:
+        """Run the scenario; a bad value found only by the scenario names the file."""
+        try:
+            return registry.get(self.scenario).run(**self.options)
+        except ValueError as error:
+            if self.source is None:
+                raise
+            raise ValueError(f"{self.source}: [options] {error}") from None
+
+
+def read_target(
+    target: str,
+    *,
+    method: str | None = None,
+    h: float | None = None,
+    t_end: float | None = None,
+) -> Target:
+    """``tumble run TARGET``: a built-in scenario's name or a scenario file, with overrides.
+
+    Parameters
+    ----------
+    target : str
+        A name of :func:`tumble.scenarios.names`, or a scenario file (``.toml``).
+    method, h, t_end : optional
+        ``--method``, ``--h`` (s), ``--t-end`` (s): set where the scenario takes them
+        (:func:`with_overrides`).
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, a bad file, an override the scenario does not take, a bad
+        value, or ``rigid-body`` by name (its body comes from a file).
+
+    Examples
+    --------
+    >>> found = read_target("t-handle", t_end=20.0)
+    >>> found.scenario, found.options, found.folder, found.source
+    ('t-handle', {'t_end': 20.0}, 't-handle', None)
+    """
+    if target.endswith(".toml") or Path(target).is_file():
+        spec = read(target)
+        name, options, animation = spec.scenario, dict(spec.options), bool(spec.outputs.animation)
+        folder = Path(target).stem
+    else:
+        registry.get(target)  # unknown names fail here, listing the known ones
+        name, options, animation, folder = target, {}, True, target
+    if name == "rigid-body" and not options:
+        raise ValueError(
+            "scenario 'rigid-body' describes your own body: run it from a TOML file "
+            "(tumble run FILE.toml; see examples/t-handle-parts.toml)"
+        )
+    options = with_overrides(name, options, method=method, h=h, t_end=t_end)
+    return Target(name, check_options(name, options), animation, folder,
+                  None if target == name else target)  # fmt: skip
+
+
+def with_overrides(scenario: str, options: Mapping[str, Any], **overrides: Any) -> dict:
+    """``options`` with each override (not None) set where ``scenario``'s ``run`` takes it.
+
+    ``method`` goes to ``methods`` (as a list of one) when the scenario takes several.
+
+    Raises
+    ------
+    ValueError
+        For an override the scenario does not take, naming it as its command-line flag.
+
+    Examples
+    --------
+    >>> with_overrides("torus-spin", {}, method="rkmk4", h=None)
+    {'methods': ['rkmk4']}
+    """
+    parameters = inspect.signature(registry.get(scenario).run).parameters
+    options = dict(options)
+    for option, value in overrides.items():
+        if value is None:
+            continue
+        if option == "method" and "method" not in parameters and "methods" in parameters:
+            options["methods"] = [value]
+        elif option in parameters:
+            options[option] = value
+        else:
+            flag = "--" + option.replace("_", "-")
+            raise ValueError(
+                f"{flag}={value!r} does not apply to scenario {scenario!r}; "
+                f"its options are {sorted(parameters)}"
+            )
+    return options
+
+
 __all__ = [
-    "METHOD_CHOICES",
-    "POSITIVE",
     "Outputs",
     "ScenarioFile",
     "Section",
     "Sweep",
+    "Target",
     "check_options",
     "options_model",
     "read",
+    "read_target",
     "validate",
+    "with_overrides",
 ]

@@ -2,12 +2,16 @@
 
 A scenario may declare its pydantic model as ``OPTIONS`` (``rigid-body`` does: its options
 are nested tables, :mod:`tumble.scenarios.rigid_body`); otherwise :func:`options_model`
-derives one from the signature of its ``run`` — names, types and defaults — with value
-rules looked up by option name: :data:`POSITIVE` (must be > 0), :data:`THREE_VECTORS` (lists
-of exactly 3 numbers), :data:`MIN_DISTINCT` (enough distinct values) and
-:data:`METHOD_CHOICES` (a method name). An option whose default is a non-empty sequence must
-be a non-empty list. Deriving keeps a single source of truth: an option added to a built-in
-``run`` is accepted in files at once, and cannot drift from a hand-written copy.
+derives one from the signature of its ``run`` — names, types and defaults — and from the
+rules its module declares beside ``run`` as ``OPTION_RULES`` (:class:`OptionRules`): which
+options must be > 0, which are 3-vectors, which lists need distinct values, and where its
+``method``/``methods`` come from. An option whose default is a non-empty sequence must be a
+non-empty list. Deriving keeps a single source of truth: an option added to a built-in
+``run`` is accepted in files at once, and cannot drift from a hand-written copy. This module
+holds only that machinery; each rule lives with its scenario.
+
+:data:`POSITIVE`, :data:`THREE_VECTORS`, :data:`MIN_DISTINCT` and :data:`METHOD_CHOICES`
+gather the built-ins' rules (read on first use, which imports every scenario module).
 
 The types and the messages come from :mod:`tumble.scenarios.schema`;
 :func:`tumble.scenarios.files.check_options` validates options with these models.
@@ -18,7 +22,8 @@ from __future__ import annotations
 import inspect
 import types
 import typing
-from collections.abc import Sequence
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
 from functools import cache
 from typing import Annotated, Any, Union
 
@@ -38,43 +43,86 @@ from tumble.scenarios.schema import (
     one_of,
 )
 
-POSITIVE = frozenset(
-    {
-        "h", "t_end", "t_max", "rtol", "speed", "g", "density", "duration", "body_mass",
-        "circumradius", "length", "major_radius", "minor_radius", "E", "rho", "width",
-        "height", "n_elements", "steps_per_period", "n_steps", "sweep_steps",
-        "frame_every", "step_counts", "record_every",
+
+@dataclass(frozen=True)
+class OptionRules:
+    """What a built-in scenario declares of its options beyond ``run``'s signature.
+
+    A scenario module sets ``OPTION_RULES = OptionRules(...)`` beside its ``run``; a module
+    without one has no rules but the signature's types and defaults.
+
+    Attributes
+    ----------
+    positive : iterable of str
+        Options that must be > 0 (every number, for a list).
+    three_vectors : iterable of str
+        Options made of 3-vectors (a point in m, a direction, an angular velocity in rad/s):
+        a list of exactly 3 numbers, or for a list of vectors (``spins``) a list of such
+        lists.
+    min_distinct : mapping of str to int
+        Options whose list needs at least this many distinct values (a slope needs two
+        steps).
+    methods : sequence of str, optional
+        The names ``method``/``methods`` may take; None: every :data:`tumble.rigid.METHODS`
+        name.
+
+    Examples
+    --------
+    >>> OptionRules(positive=["h", "t_end"]).positive == {"h", "t_end"}
+    True
+    """
+
+    positive: Iterable[str] = frozenset()
+    three_vectors: Iterable[str] = frozenset()
+    min_distinct: Mapping[str, int] = field(default_factory=dict)
+    methods: Sequence[str] | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "positive", frozenset(self.positive))
+        object.__setattr__(self, "three_vectors", frozenset(self.three_vectors))
+        object.__setattr__(self, "min_distinct", dict(self.min_distinct))
+        if self.methods is not None:
+            object.__setattr__(self, "methods", tuple(self.methods))
+
+    def names(self) -> set[str]:
+        """Every option a rule names (each must be an option of the scenario's ``run``)."""
+        return {*self.positive, *self.three_vectors, *self.min_distinct}
+
+
+def rules(scenario: str) -> OptionRules:
+    """``scenario``'s declared :class:`OptionRules` (none declared: no rules).
+
+    Examples
+    --------
+    >>> sorted(rules("t-handle").positive), sorted(rules("t-handle").three_vectors)
+    (['h', 'rtol', 't_end'], ['spins'])
+    """
+    return getattr(_scenario(scenario), "OPTION_RULES", OptionRules())
+
+
+def _gathered() -> dict[str, Any]:
+    """The built-ins' rules gathered by kind (what :data:`POSITIVE` and the others hold)."""
+    declared = {name: rules(name) for name in registry.names() if name != "rigid-body"}
+    return {
+        "POSITIVE": frozenset().union(*(r.positive for r in declared.values())),
+        "THREE_VECTORS": frozenset().union(*(r.three_vectors for r in declared.values())),
+        "MIN_DISTINCT": {k: v for r in declared.values() for k, v in r.min_distinct.items()},
+        "METHOD_CHOICES": {n: r.methods for n, r in declared.items() if r.methods is not None},
     }
-)  # fmt: skip
-"""Options of a built-in scenario that must be > 0 (every number, for a list)."""
-THREE_VECTORS = frozenset({"center", "hit_from", "vertex", "omega0", "spins"})
-"""Options of a built-in scenario made of 3-vectors (a point in m, a direction, an angular
-velocity in rad/s): a list of exactly 3 numbers, or for a list of vectors (``spins``) a list
-of such lists."""
-MIN_DISTINCT = {"step_counts": 2}
-"""Options whose list needs at least this many distinct values (a slope needs two steps)."""
+
+
+def __getattr__(name: str) -> Any:
+    """:data:`POSITIVE`, :data:`THREE_VECTORS`, :data:`MIN_DISTINCT`, :data:`METHOD_CHOICES`:
+    the rules every built-in scenario declares, gathered by kind on first use."""
+    if name in ("POSITIVE", "THREE_VECTORS", "MIN_DISTINCT", "METHOD_CHOICES"):
+        return _gathered()[name]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def _rigid_methods() -> list[str]:
     from tumble.rigid import METHODS
 
     return list(METHODS)
-
-
-def _fixed_step_rigid_methods() -> list[str]:
-    from tumble.scenarios._common import fixed_step_methods
-
-    return list(fixed_step_methods())
-
-
-def _ode_methods() -> list[str]:
-    from tumble.ode import TABLEAUX
-
-    return list(TABLEAUX)
-
-
-METHOD_CHOICES = {"projectile": _ode_methods, "convergence": _fixed_step_rigid_methods}
-"""Where a scenario's ``method``/``methods`` come from; others: :data:`tumble.rigid.METHODS`."""
 
 
 def _numbers(value: Any) -> list[float]:
@@ -141,20 +189,21 @@ def _field_type(annotation: Any, default: Any, vector: bool = False) -> Any:
     return Any
 
 
-def _option(scenario: str, name: str, parameter: inspect.Parameter, annotation: Any):
+def _option(declared: OptionRules, name: str, parameter: inspect.Parameter, annotation: Any):
     default = parameter.default
     if isinstance(default, tuple):
         default = list(default)
-    kind = _field_type(annotation, default, vector=name in THREE_VECTORS)
+    kind = _field_type(annotation, default, vector=name in declared.three_vectors)
     checks = []
     if isinstance(default, list) and default:
         checks.append(AfterValidator(_non_empty))
-    if name in MIN_DISTINCT:
-        checks.append(_distinct(MIN_DISTINCT[name]))
-    if name in POSITIVE:
+    if name in declared.min_distinct:
+        checks.append(_distinct(declared.min_distinct[name]))
+    if name in declared.positive:
         checks.append(AfterValidator(_positive))
     if name in ("method", "methods"):
-        checks.append(AfterValidator(one_of(METHOD_CHOICES.get(scenario, _rigid_methods)())))
+        choices = declared.methods if declared.methods is not None else _rigid_methods()
+        checks.append(AfterValidator(one_of(list(choices))))
     if checks:
         kind = Annotated[kind, *checks]
     required = default is inspect.Parameter.empty
@@ -176,12 +225,13 @@ def options_model(scenario: str) -> type[BaseModel]:
     ['h', 'method', 'rtol', 'spins', 't_end']
     """
     module = _scenario(scenario)
-    declared = getattr(module, "OPTIONS", None)
-    if declared is not None:
-        return declared
+    model = getattr(module, "OPTIONS", None)
+    if model is not None:
+        return model
+    declared = rules(scenario)
     hints = typing.get_type_hints(module.run)
     fields = {
-        name: _option(scenario, name, parameter, hints.get(name, Any))
+        name: _option(declared, name, parameter, hints.get(name, Any))
         for name, parameter in inspect.signature(module.run).parameters.items()
         if parameter.kind is inspect.Parameter.KEYWORD_ONLY
     }
@@ -198,4 +248,5 @@ def _scenario(name: Any):
     return registry.get(name)
 
 
-__all__ = ["METHOD_CHOICES", "MIN_DISTINCT", "POSITIVE", "THREE_VECTORS", "options_model"]
+__all__ = ["OptionRules", "options_model", "rules"]  # and, gathered on first use, POSITIVE,
+# THREE_VECTORS, MIN_DISTINCT and METHOD_CHOICES (module __getattr__)

@@ -28,8 +28,9 @@ from numpy.typing import ArrayLike
 from tumble import _checks, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import Impulse, RigidBody, simulate
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import method_names
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import rigid
 
 NAME = "prism-impulse"
@@ -37,6 +38,11 @@ SUMMARY = "Seed 001: a hexagonal prism hit at a vertex by an impulse, then free 
 
 METHODS = ("euler", "rk4-quat", "rkmk4")
 """Seed 001's Euler and RK4 on the quaternion, and RKMK4 for comparison."""
+OPTION_RULES = OptionRules(
+    positive=["t_end", "h", "duration", "body_mass", "circumradius", "length"],
+    three_vectors=["center", "hit_from", "vertex"],
+)
+"""What :func:`run`'s options must be beyond its signature: points are 3-vectors (m)."""
 CENTER = (50.0, 10.0, 10.0)
 """Centre of mass of the prism (m)."""
 HIT_FROM = (40.0, 20.0, 10.0)
@@ -156,16 +162,12 @@ def run(
         summary,
         {"trajectories": runs, "body": body},
         figures,
-        datasets=rigid_datasets(runs, body_mesh, shown),
         attrs=rigid_attrs(
             body, methods=list(methods), h=h, t_end=t_end, impulse=impulse.impulse.tolist()
         ),
-        animations=rigid_animations(
-            runs[shown],
-            body_mesh,
-            title=f"{title}, {shown}",
-            loads=(impulse,),
-        ),
+        **rigid_outputs(
+            runs, body_mesh, shown=shown, title=f"{title}, {shown}", loads=(impulse,)
+        ),  # fmt: skip
     )
 
 

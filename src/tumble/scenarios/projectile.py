@@ -8,10 +8,13 @@ import numpy as np
 
 from tumble import _checks
 from tumble.io import ScenarioResult
-from tumble.ode import solve
+from tumble.ode import TABLEAUX, solve
+from tumble.scenarios.option_models import OptionRules
 
 NAME = "projectile"
 SUMMARY = "Seed 000: a 1 kg point mass launched at 500 m/s, 45°; the impact found by an event."
+OPTION_RULES = OptionRules(positive=["speed", "g", "h", "t_max"], methods=list(TABLEAUX))
+"""What :func:`run`'s options must be: the method is an ODE tableau (any angle is allowed)."""
 
 
 def _ground(t: float, y: np.ndarray) -> float:

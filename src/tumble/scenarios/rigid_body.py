@@ -23,11 +23,14 @@ mass); ``torque`` (N m, world frame); ``impulse`` (``impulse`` in N s at the wor
 ``point`` at ``time``).
 
 The body models are in :mod:`tumble.scenarios.bodies`; this module holds the rest of
-:data:`OPTIONS` (initial state, loads, method) and :func:`run`.
+:data:`OPTIONS` (initial state, loads, method), :func:`prepare` (the body, its loads, its
+initial state and ``simulate``'s settings, built from checked options: what :func:`run`
+simulates, and what a sweep's members share, :mod:`tumble.sweeps.members`) and :func:`run`.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from functools import partial
 from typing import Annotated, Any, ClassVar, Literal
 
@@ -36,10 +39,21 @@ from pydantic import AfterValidator, Field, model_validator
 
 from tumble import so3
 from tumble.io import ScenarioResult
-from tumble.rigid import Force, Gravity, Impulse, RigidBody, Torque, Trajectory, simulate
+from tumble.mass import MassProperties
+from tumble.rigid import (
+    BatchTrajectory,
+    Force,
+    Gravity,
+    Impulse,
+    RigidBody,
+    Torque,
+    Trajectory,
+    simulate,
+    simulate_batch,
+)
 from tumble.rigid.initial import check_steps, initial_attitude
 from tumble.rigid.methods import METHODS, get_method
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios._base import rigid_attrs, rigid_outputs
 from tumble.scenarios._common import json_number
 from tumble.scenarios.bodies import Body
 from tumble.scenarios.schema import (
@@ -181,6 +195,92 @@ class Options(Section):
 OPTIONS = Options
 """The options model :func:`tumble.scenarios.files.check_options` uses for this scenario."""
 
+# --- a run, prepared -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Preparation:
+    """A run of checked options, ready to simulate: the body, its loads, its initial state.
+
+    Attributes
+    ----------
+    options : Options
+        The checked options.
+    properties : tumble.mass.MassProperties
+        The described body's mass, centre of mass ``com`` (m, the description's
+        coordinates) and inertia about it (kg m², body axes).
+    body : RigidBody
+        The simulated body (centre of mass at the origin of its frame).
+    forces : list
+        The loads, built (:mod:`tumble.rigid.forces`; points relative to the centre of mass).
+    start : dict
+        ``simulate``'s initial state: ``x0`` (m; the centre of mass unless given), ``v0``,
+        ``R0`` (from ``R0``, ``q0`` or ``euler_zyx``), ``omega0``, ``L0`` (None: not given).
+    """
+
+    options: Options
+    properties: MassProperties
+    body: RigidBody
+    forces: list
+    start: dict[str, Any]
+
+    @property
+    def com(self) -> np.ndarray:
+        """The centre of mass in the description's coordinates (m), shape (3,)."""
+        return np.asarray(self.properties.com)
+
+    @property
+    def batchable(self) -> bool:
+        """Whether runs from other initial states can share one ``simulate_batch`` call: a
+        fixed-step method under constant loads (no impulse, no callable load)."""
+        constant = all(getattr(load, "compiled", False) for load in self.forces)
+        impulses = any(isinstance(load, Impulse) for load in self.forces)
+        return not get_method(self.options.method).adaptive and constant and not impulses
+
+    def simulate(self, **start: Any) -> Trajectory:
+        """:func:`~tumble.rigid.simulate` from :attr:`start`, entries of ``start`` replaced."""
+        o = self.options
+        return simulate(self.body, o.t_end, method=o.method, h=o.h, rtol=o.rtol, atol=o.atol,
+                        forces=self.forces, record_every=o.record_every,
+                        **{**self.start, **start})  # fmt: skip
+
+    def simulate_batch(self, **starts: Any) -> BatchTrajectory:
+        """:func:`~tumble.rigid.simulate_batch` from per-run initial states (arrays of rows:
+        ``x0``, ``v0``, ``R0``, ``omega0``, ``L0``; only when :attr:`batchable`)."""
+        o = self.options
+        return simulate_batch(self.body, o.t_end, method=o.method, h=o.h, forces=self.forces,
+                              record_every=o.record_every, **starts)  # fmt: skip
+
+
+def prepare(options: Options) -> Preparation:
+    """The body, loads and initial state of checked ``options`` (:func:`run` simulates them).
+
+    Examples
+    --------
+    >>> options = validate(Options, {"body": {"shape": "sphere", "radius": 0.1, "mass": 1.0},
+    ...                              "initial": {"omega0": [0.0, 0.0, 2.0]}})
+    >>> ready = prepare(options)
+    >>> ready.start["x0"].tolist(), ready.start["omega0"], ready.batchable
+    ([0.0, 0.0, 0.0], [0.0, 0.0, 2.0], True)
+    """
+    properties = options.body.mass_properties()
+    com = np.asarray(properties.com)
+    start = options.initial
+    return Preparation(
+        options=options,
+        properties=properties,
+        body=RigidBody.from_mass_properties(properties),
+        forces=[load.build(com) for load in options.loads],
+        start={
+            "x0": com if start.x0 is None else start.x0,
+            "v0": start.v0,
+            "R0": start.attitude(),
+            "omega0": start.omega0,
+            "L0": start.L0,
+        },
+    )
+
+
 # --- the run ---------------------------------------------------------------------------------
 
 
@@ -261,27 +361,10 @@ def run(
         "record_every": record_every,
     }
     options = validate(Options, given)
-    properties = options.body.mass_properties()
-    rigid_body = RigidBody.from_mass_properties(properties)
-    com = np.asarray(properties.com)
+    ready = prepare(options)
+    properties, rigid_body, forces, com = ready.properties, ready.body, ready.forces, ready.com
     surface = options.body.surface().apply_translation(-com)
-    forces = [load.build(com) for load in options.loads]
-    start = options.initial
-    trajectory = simulate(
-        rigid_body,
-        options.t_end,
-        method=options.method,
-        h=options.h,
-        rtol=options.rtol,
-        atol=options.atol,
-        x0=com if start.x0 is None else start.x0,
-        v0=start.v0,
-        R0=start.attitude(),
-        omega0=start.omega0,
-        L0=start.L0,
-        forces=forces,
-        record_every=options.record_every,
-    )
+    trajectory = ready.simulate()
     summary = _summary(options, properties, trajectory, forces)
     title = f"{NAME}: {options.body.label()} — {_setting(options)}"
     return ScenarioResult(
@@ -289,7 +372,6 @@ def run(
         summary=summary,
         data={"trajectory": trajectory, "body": rigid_body, "mesh": surface, "options": options},
         figures=_figures(trajectory, surface, title, summary["conserved"]),
-        datasets=rigid_datasets({options.method: trajectory}, surface, options.method),
         attrs=rigid_attrs(
             rigid_body,
             method=options.method,
@@ -300,7 +382,7 @@ def run(
             body_kind=options.body.label(),
             com=com.tolist(),
         ),
-        animations=rigid_animations(trajectory, surface, title=title, loads=tuple(forces)),
+        **rigid_outputs({options.method: trajectory}, surface, title=title, loads=tuple(forces)),
     )
 
 

@@ -23,14 +23,17 @@ from tumble import exact, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody
 from tumble.rigid import methods as rigid_methods
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import method_names, simulate_method
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import rigid
 
 NAME = "sphere-exact"
 SUMMARY = "Seed 002 tasks 2–4: the unit sphere spun about x; every method against exp(t x̃)."
 
 METHODS = tuple(rigid_methods.METHODS)
+OPTION_RULES = OptionRules(positive=["h", "t_end", "rtol"])
+"""What :func:`run`'s options must be beyond its signature."""
 """The methods compared by default: every one of :data:`tumble.rigid.METHODS`, in its order."""
 OMEGA0 = (1.0, 0.0, 0.0)
 """Seed 002's initial angular velocity (rad/s); with I = Id also L (kg m²/s)."""
@@ -95,9 +98,8 @@ def run(
         summary=summary,
         data={"trajectories": runs, "errors": errors},
         figures=_figures(runs, errors, title),
-        datasets=rigid_datasets(runs, mesh, shown),
         attrs=rigid_attrs(body, methods=list(methods), h=h, rtol=rtol, t_end=t_end),
-        animations=rigid_animations(runs[shown], mesh, title=f"{title}, {shown}"),
+        **rigid_outputs(runs, mesh, shown=shown, title=f"{title}, {shown}"),
     )
 
 

@@ -27,13 +27,17 @@ import numpy as np
 from tumble import _checks, mass, meshes, so3
 from tumble.io import ScenarioResult
 from tumble.rigid import Gravity, RigidBody, simulate
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import json_number, method_names
+from tumble.scenarios.option_models import OptionRules
 
 NAME = "spinning-top"
 SUMMARY = "A heavy symmetric top on its tip: precession and nutation between the classical bounds."
 
 METHODS = ("yoshida4", "rkmk4")
+OPTION_RULES = OptionRules(positive=["t_end", "h", "density"])
+"""What :func:`run`'s options must be beyond its signature (the tilt and spin are checked by
+:func:`run`)."""
 """The methods compared by default: splitting on the exact flow, and RKMK4."""
 G = 9.81
 """Gravity (m/s², along −z)."""
@@ -158,11 +162,10 @@ def run(
         summary=summary,
         data={"trajectories": runs, "body": body, "tip": tip},
         figures=_figures(runs, np.degrees(bounds), title, summary, x_tip),
-        datasets=rigid_datasets(runs, mesh, shown),
         attrs=rigid_attrs(
             body, methods=list(methods), h=h, t_end=t_end, tilt=tilt, spin=spin, tip=tip.tolist()
         ),  # fmt: skip
-        animations=rigid_animations(runs[shown], mesh, title=f"{title}, {shown}"),
+        **rigid_outputs(runs, mesh, shown=shown, title=f"{title}, {shown}"),
     )
 
 

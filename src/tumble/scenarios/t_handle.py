@@ -28,7 +28,8 @@ from tumble import _checks, exact, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, Trajectory, flip_event, simulate
 from tumble.rigid.forces import State
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets
+from tumble.scenarios._base import rigid_attrs, rigid_outputs
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import rigid
 
 NAME = "t-handle"
@@ -38,6 +39,8 @@ SUMMARY = (
 
 SPINS = ((1.0, 0.05, 0.0), (0.0, 1.0, 0.05), (0.05, 0.0, 1.0))
 """Seed 002's initial body angular velocities (rad/s)."""
+OPTION_RULES = OptionRules(positive=["h", "t_end", "rtol"], three_vectors=["spins"])
+"""What :func:`run`'s options must be beyond its signature: each spin is a 3-vector."""
 FLIP_METHOD, FLIP_RTOL = "rkmk-dopri5", 1e-10
 """How :func:`flip_times` integrates: the error it leaves in a flip time is about 1e-11 of
 the half period per flip (measured)."""
@@ -73,11 +76,63 @@ def zero_crossings(t: np.ndarray, values: np.ndarray) -> np.ndarray:
     return t[k] - values[k] * (t[k + 1] - t[k]) / (values[k + 1] - values[k])
 
 
-def measured_period(t: np.ndarray, omega: np.ndarray) -> tuple[float | None, int, np.ndarray]:
-    """The period of ω_body(t) from the zero crossings of its most-crossing component.
+def measured_periods(t: np.ndarray, omega: np.ndarray) -> np.ndarray:
+    """The period of each run's ω_body(t), from the zero crossings of its most-crossing component.
 
     Every other crossing is in the same direction, one period later; the period is the mean
-    of ``c[k + 2] − c[k]``.
+    of ``c[k + 2] − c[k]`` over the crossings ``c`` (:func:`zero_crossings`: a zero counts
+    as positive, linear interpolation between samples). That mean telescopes to
+    ``(c[-1] + c[-2] − c[0] − c[1]) / (len(c) − 2)``, so only the first two and last two
+    crossings of each run are located: many runs at once cost a few array passes (a sweep's
+    ``flip_period``, :mod:`tumble.sweeps.variables`).
+
+    Parameters
+    ----------
+    t : ndarray, shape (n,)
+        Times (s), shared by every run.
+    omega : ndarray, shape (m, n, 3)
+        Body angular velocities (rad/s); NaN after a run that stopped.
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        The periods (s); NaN where fewer than three crossings were seen (run longer).
+
+    Examples
+    --------
+    >>> t = np.linspace(0.0, 20.0, 2001)
+    >>> spins = np.stack([np.cos(t), np.sin(t), np.ones_like(t)], axis=1)
+    >>> np.round(measured_periods(t, np.stack([spins, spins[:, [2, 0, 1]]])), 5)
+    array([6.28319, 6.28319])
+    """
+    with np.errstate(invalid="ignore", divide="ignore"):
+        positive = omega >= 0
+        changes = positive[:, :-1] != positive[:, 1:]  # (m, n - 1, 3)
+        component = np.argmax(changes.sum(axis=1), axis=1)
+        rows = np.arange(len(omega))
+        values = omega[rows, :, component]  # (m, n)
+        crossing = changes[rows, :, component]
+        count = crossing.sum(axis=1)
+        dt = t[1:] - t[:-1]
+        times = t[:-1] - values[:, :-1] * dt / (values[:, 1:] - values[:, :-1])
+        order = np.cumsum(crossing, axis=1)
+        first = _crossing(times, order, crossing, 1)
+        second = _crossing(times, order, crossing, 2)
+        last = _crossing(times, order, crossing, count)
+        before_last = _crossing(times, order, crossing, count - 1)
+        period = (last + before_last - first - second) / (count - 2)
+    return np.where(count >= 3, period, np.nan)
+
+
+def _crossing(times: np.ndarray, order: np.ndarray, crossing: np.ndarray, k) -> np.ndarray:
+    """The time of each run's ``k``-th crossing (1-based; NaN where there is none)."""
+    hit = crossing & (order == np.reshape(k, (-1, 1)))
+    index = np.argmax(hit, axis=1)
+    return np.where(hit.any(axis=1), times[np.arange(len(times)), index], np.nan)
+
+
+def measured_period(t: np.ndarray, omega: np.ndarray) -> tuple[float | None, int, np.ndarray]:
+    """One run's :func:`measured_periods`, with the component and the crossings it used.
 
     Parameters
     ----------
@@ -97,10 +152,8 @@ def measured_period(t: np.ndarray, omega: np.ndarray) -> tuple[float | None, int
     """
     crossings = [zero_crossings(t, omega[:, k]) for k in range(3)]
     component = int(np.argmax([len(c) for c in crossings]))
-    chosen = crossings[component]
-    if len(chosen) < 3:
-        return None, component, chosen
-    return float(np.mean(chosen[2:] - chosen[:-2])), component, chosen
+    period = float(measured_periods(t, omega[None])[0])
+    return (None if np.isnan(period) else period), component, crossings[component]
 
 
 def flip_times(body: RigidBody, omega0, t_end: float) -> np.ndarray:
@@ -221,13 +274,13 @@ def run(
         summary=summary,
         data={"trajectories": runs, "body": body, "crossings": crossings},
         figures=_figures(summary, runs, crossings),
-        datasets=rigid_datasets(
-            {f"spin{k}": run for k, run in enumerate(runs, start=1)}, mesh, f"spin{shown + 1}"
-        ),
         attrs=rigid_attrs(body, method=method, h=h, rtol=rtol, t_end=t_end),
-        animations=rigid_animations(
-            runs[shown], mesh, title=f"{NAME} — {_label(summary['spins'][shown])}\n{setting}"
-        ),
+        **rigid_outputs(
+            {f"spin{k}": run for k, run in enumerate(runs, start=1)},
+            mesh,
+            shown=f"spin{shown + 1}",
+            title=f"{NAME} — {_label(summary['spins'][shown])}\n{setting}",
+        ),  # fmt: skip
     )
 
 

@@ -25,14 +25,19 @@ import numpy as np
 from tumble import exact, mass, meshes
 from tumble.io import ScenarioResult
 from tumble.rigid import RigidBody, simulate
-from tumble.scenarios._base import rigid_animations, rigid_attrs, rigid_datasets, showcase
+from tumble.scenarios._base import rigid_attrs, rigid_outputs, showcase
 from tumble.scenarios._common import json_number, method_names
+from tumble.scenarios.option_models import OptionRules
 from tumble.viz import rigid
 
 NAME = "torus-spin"
 SUMMARY = "Seed 000: a free torus spun at ω(0) = (1, 1, 1); rk4-matrix drifts off SO(3)."
 
 METHODS = ("rk4-matrix", "rk4-quat", "lie-euler", "rkmk4")
+OPTION_RULES = OptionRules(
+    positive=["t_end", "h", "major_radius", "minor_radius", "density"], three_vectors=["omega0"]
+)
+"""What :func:`run`'s options must be beyond its signature: ω₀ is a 3-vector (rad/s)."""
 """The methods compared by default."""
 OMEGA0 = (1.0, 1.0, 1.0)
 """Seed 000's angular velocity (rad/s), here the initial body-frame value."""
@@ -102,13 +107,8 @@ def run(
         summary=summary,
         data={"trajectories": runs, "body": body},
         figures=_figures(body, runs, exact_R, title, omega0),
-        datasets=rigid_datasets(runs, mesh, shown),
         attrs=rigid_attrs(body, methods=list(methods), h=h, t_end=t_end, omega0=list(omega0)),
-        animations=rigid_animations(
-            runs[shown],
-            mesh,
-            title=f"{title}, {shown}",
-        ),
+        **rigid_outputs(runs, mesh, shown=shown, title=f"{title}, {shown}"),
     )
 
 

@@ -13,6 +13,30 @@ def swept_dims(dataset) -> list[str]:
     return [dim for dim in grid if dataset.sizes[dim] > 1]
 
 
+DEFAULT_MAP = "flip_period"
+"""What ``tumble sweep`` draws without ``--map``: the flip period, on a grid of two swept
+dimensions."""
+NO_PERIOD = ("no flip period measured (fewer than three crossings): no map; run longer, or "
+             "choose another variable with --map")  # fmt: skip
+"""Why ``tumble sweep`` draws no default map when no member measured a period."""
+
+
+def map_variable(dataset, requested: str | None) -> tuple[str | None, str]:
+    """``(variable to draw or None, a note why none)`` for ``tumble sweep --map``.
+
+    ``requested`` is drawn whatever it holds (:func:`draw_map` checks it); without one,
+    :data:`DEFAULT_MAP` when the sweep has it over exactly two swept dimensions and some
+    member measured it (else the note :data:`NO_PERIOD`).
+    """
+    if requested:
+        return requested, ""
+    if len(swept_dims(dataset)) != 2 or DEFAULT_MAP not in dataset:
+        return None, ""
+    if dataset[DEFAULT_MAP].isnull().all():
+        return None, NO_PERIOD
+    return DEFAULT_MAP, ""
+
+
 def draw_map(dataset, variable: str, path: str | Path, *, title: str = "") -> Path:
     """A heat map of ``variable`` over the two swept dimensions of a grid sweep.
 

@@ -41,6 +41,7 @@ from tumble.scenarios.files import check_options, read
 from tumble.scenarios.option_models import options_model
 from tumble.scenarios.schema import short_repr, validate
 from tumble.sweeps.text import grid_from_table
+from tumble.sweeps.variables import VARIABLES, WALL_TIME, member_bytes
 
 RIGID = "rigid-body"
 """The scenario whose members are trajectories (batched); any other stores its summary."""
@@ -50,10 +51,6 @@ MAX_CHUNK = 16384
 """Default largest number of members in one task: a task's fixed cost (writing its region and
 flags, about 30 ms; its bookkeeping) should stay small beside its compiled loop (16384 free
 bodies of 300 ``rkmk4`` steps: about 0.25 s on one core)."""
-SERIES_BYTES = 8 * (3 + 3 + 9 + 3 + 3 + 1)
-"""Bytes of one member's sample: x, v, R, L_world, omega_body, energy."""
-SUMMARY_BYTES = 64
-"""Bytes of one member's summary variables (about)."""
 TIME_GRID = ("h", "t_end", "record_every")
 """Options that set a member's sample times: swept, the members share no time axis."""
 
@@ -365,7 +362,8 @@ def make_plan(
     samples : mapping of str to sequence, sequence of mappings, or DataFrame, optional
         One member per row, instead of ``grid``.
     chunk : int, optional
-        Members per task; default: tasks of about :data:`CHUNK_BYTES` of output, at most
+        Members per task; default: tasks of about :data:`CHUNK_BYTES` of output (the bytes
+        of a member from the rows of :data:`tumble.sweeps.variables.VARIABLES`), at most
         :data:`MAX_CHUNK` members.
 
     Returns
@@ -410,7 +408,9 @@ def make_plan(
         raise _checks.fail("grid", list(columns), "each option path at most once")
     shape = (len(values[0]),) if samples is not None else tuple(map(len, values))
     time = shared_time(options, paths, values) if name == RIGID else None
-    per_member = SUMMARY_BYTES + (0 if time is None else len(time) * SERIES_BYTES)
+    # a built-in's summary numbers are named by its first run (sweep's _probed), after this
+    rows = VARIABLES if name == RIGID else {WALL_TIME: VARIABLES[WALL_TIME]}
+    per_member = member_bytes(None if time is None else len(time), rows)
     chunks = _chunks(shape, _chunk(chunk, per_member))
     return Plan(options, dims, tuple(paths), tuple(values), samples is not None, chunks,
                 source, digest, time, tuple(columns), name)  # fmt: skip

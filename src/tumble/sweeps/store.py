@@ -7,9 +7,10 @@ The layout (one ``xarray.Dataset``, Zarr format 2 with consolidated metadata, so
   its values; or one ``member`` dimension whose coordinates are the samples' columns;
 * ``time`` (s), shared by every member, and ``axis``, ``row``, ``col`` for vectors and
   matrices;
-* per member the series of :data:`~tumble.sweeps.members.SERIES` (dims ``(*members, time,
-  …)``; absent when the members share no time axis) and the summary variables of
-  :data:`~tumble.sweeps.members.SUMMARY`, each with CF ``units`` and ``long_name``;
+* per member the variables of :data:`~tumble.sweeps.variables.VARIABLES`: the series (dims
+  ``(*members, time, …)``; absent when the members share no time axis) and the summary
+  variables, each with CF ``units`` and ``long_name`` (a built-in's: its summary's numbers
+  and ``wall_time``);
 * ``done`` (1 when the member is complete), written after the member's data;
 * attributes: ``tumble_version``, ``scenario``, ``scenario_source``, ``scenario_sha256``,
   ``grid`` (JSON), ``options`` (JSON), ``chunk``.
@@ -30,12 +31,11 @@ from typing import Literal
 import numpy as np
 
 from tumble._version import __version__
-from tumble.sweeps.members import SERIES, SUMMARY
 from tumble.sweeps.plan import RIGID, Plan, dim_path
+from tumble.sweeps.variables import EXTRA_DIMS, SERIES, SUMMARY, WALL_TIME, Variable
 
 FORMAT: Literal[2] = 2
 """Zarr format: version 2 has consolidated metadata and string arrays in its specification."""
-_EXTRA = {"axis": ["x", "y", "z"], "row": [0, 1, 2], "col": [0, 1, 2]}
 
 
 def _coords(plan: Plan) -> dict:
@@ -49,7 +49,7 @@ def _coords(plan: Plan) -> dict:
             coords[dim] = (dim, _array(values), {"option_path": dim_path(path)})
     if plan.time is not None:
         coords["time"] = ("time", plan.time, {"units": "s", "long_name": "time"})
-        coords.update({name: (name, values) for name, values in _EXTRA.items()})
+        coords.update({name: (name, values) for name, values in EXTRA_DIMS.items()})
     return coords
 
 
@@ -70,28 +70,30 @@ def template(plan: Plan):
     variables = {}
     if plan.time is not None:
         n = len(plan.time)
-        for name, (extra, units, text) in SERIES.items():
-            data = da.full((*shape, n, *(3 for _ in extra)), np.nan,
-                           chunks=(*chunks, n, *(3 for _ in extra)))  # fmt: skip
-            attrs = {"units": units, "long_name": text}
-            variables[name] = ((*plan.dims, "time", *extra), data, attrs)
-    for name, (dtype, units, text) in _summary(plan).items():
-        fill = np.nan if dtype.startswith("float") else 0
-        data = da.full(shape, fill, dtype=dtype, chunks=chunks)
-        variables[name] = (plan.dims, data, {"units": units, "long_name": text})
+        for name, row in SERIES.items():
+            extra = tuple(len(EXTRA_DIMS[dim]) for dim in row.extra)
+            data = da.full((*shape, n, *extra), np.nan, dtype=row.dtype,
+                           chunks=(*chunks, n, *extra))  # fmt: skip
+            attrs = {"units": row.units, "long_name": row.long_name}
+            variables[name] = ((*plan.dims, "time", *row.extra), data, attrs)
+    for name, row in _summary(plan).items():
+        fill = np.nan if row.dtype.startswith("float") else 0
+        data = da.full(shape, fill, dtype=row.dtype, chunks=chunks)
+        variables[name] = (plan.dims, data, {"units": row.units, "long_name": row.long_name})
     done = "1 when the member's data are complete (written after them); 0: run it again"
     variables["done"] = (plan.dims, da.zeros(shape, dtype="uint8", chunks=chunks),
                          {"long_name": done})  # fmt: skip
     return xr.Dataset(variables, coords=_coords(plan), attrs=attributes(plan))
 
 
-def _summary(plan: Plan) -> dict:
+def _summary(plan: Plan) -> dict[str, Variable]:
     """The per-member variables: a trajectory's summary, or a built-in's summary numbers."""
     if plan.scenario == RIGID:
         return SUMMARY
     where = f"summary.json of scenario {plan.scenario!r} (units as documented there)"
-    numbers = {name: ("float64", "", f"{name} from {where}") for name in plan.outputs}
-    return {**numbers, "wall_time": SUMMARY["wall_time"]}
+    numbers = {name: Variable((), "float64", "", f"{name} from {where}", None)
+               for name in plan.outputs}  # fmt: skip
+    return {**numbers, WALL_TIME: SUMMARY[WALL_TIME]}
 
 
 def attributes(plan: Plan) -> dict:
@@ -126,7 +128,7 @@ def write_region(plan: Plan, store: str | Path, task: tuple[int, ...], values: d
     block = tuple(s.stop - s.start for s in region.values())
     data = {}
     for name, array in values.items():
-        extra = SERIES[name][0] if name in SERIES else None
+        extra = SERIES[name].extra if name in SERIES else None
         dims = plan.dims if extra is None else (*plan.dims, "time", *extra)
         data[name] = (dims, array.reshape(*block, *array.shape[1:]))
     xr.Dataset(data).to_zarr(store, region=region, mode="r+", consolidated=False)

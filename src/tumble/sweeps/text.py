@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -39,6 +39,27 @@ def parse_values(key: str, text: str) -> list:
     if len(parts) != 3 or count < 1 or not (math.isfinite(start) and math.isfinite(stop)):
         raise _checks.fail(f"grid {key}", text, allowed)
     return np.linspace(start, stop, count).tolist()
+
+
+def grid_from_arguments(items: Sequence[str]) -> dict[str, list] | None:
+    """The ``--grid PATH=VALUES`` arguments as dotted path → values; None for none.
+
+    Examples
+    --------
+    >>> grid_from_arguments(["omega0.1=0:0.1:3", "method=rkmk4"])
+    {'omega0.1': [0.0, 0.05, 0.1], 'method': ['rkmk4']}
+    >>> grid_from_arguments(["h"])
+    Traceback (most recent call last):
+    ...
+    ValueError: --grid 'h': must be PATH=VALUES, e.g. omega0.1=0:0.1:5
+    """
+    grid = {}
+    for item in items:
+        key, sign, text = item.partition("=")
+        if not sign:
+            raise ValueError(f"--grid {item!r}: must be PATH=VALUES, e.g. omega0.1=0:0.1:5")
+        grid[key.strip()] = parse_values(key.strip(), text)
+    return grid or None
 
 
 def _scalar(text: str) -> Any:
