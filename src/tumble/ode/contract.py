@@ -145,8 +145,6 @@ class Stepper:
     error_order: int = 1
     blocks: bool = False
     """Whether :meth:`march_block` runs a fixed grid compiled."""
-    in_place: bool = False
-    """Whether ``step`` overwrites its ``state`` (then no events, no adaptive control)."""
     time_axis: int = 0
     """The axis of :meth:`record`'s arrays along which samples are stacked."""
     block_steps: int | None = None

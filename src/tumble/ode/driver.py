@@ -15,8 +15,8 @@ A stepper is an object with (see :class:`Stepper`, which gives the defaults):
     Order ``q`` of that estimate (the controller's exponent is ``1/(q + 1)``).
 ``step(t, state, h) -> (new_state, error)``
     One step from ``state`` at ``t``. ``error`` is the local error estimate (an array in the
-    units of :meth:`~Stepper.scale`) or None. It must not change ``state`` unless it is
-    never needed again (no events, no retries: :attr:`~Stepper.in_place`).
+    units of :meth:`~Stepper.scale`) or None. It must not change ``state``: the driver may
+    need it again (events, a rejected step).
 ``accept(t, state)``
     Told that a step to ``(t, state)`` was accepted (first-same-as-last data, counters).
 ``interpolant(t_old, old, t_new, new) -> sol``
