@@ -20,8 +20,9 @@ is Runge–Kutta–Munthe-Kaas (Munthe-Kaas 1998): the right-trivialised equatio
 
 A chart is Python data here (pack, map back, vector field) and a compiled twin in
 :mod:`tumble.rigid.kernels` (a numba field, map back and record), which a test checks
-against this reference to round-off. Adding a family costs one :class:`Chart`, its Python
-field, and its numba field.
+against this reference to round-off. Adding a chart family costs one :class:`Chart`, its
+Python field, its numba field, and its :class:`~tumble.rigid.families.ChartFamily` in
+:data:`tumble.rigid.methods.FAMILIES`.
 """
 
 from __future__ import annotations

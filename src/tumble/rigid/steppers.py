@@ -8,7 +8,7 @@ round-off. Both plug into :func:`tumble.ode.driver.march`, which owns the time l
 
 :class:`SplitStepper` and :class:`CompiledSplitStepper` are the same pair for the ``split``
 family: one step of :func:`~tumble.rigid.geometric.split_step` in NumPy, and its compiled
-loop.
+loop. The method's family (:mod:`tumble.rigid.families`) chooses and builds them.
 
 The stepped state is ``(attitude, Y)``: the chart's attitude (R, or q for the ``quat`` chart,
 or ``R_p = R P`` in the principal frame for the ``split`` family) and ``Y = (x, p, L)``,
