@@ -212,7 +212,7 @@ def simulate(
             R0=R0, q0=q0, omega0=omega0, L0=L0, forces=forces, events=events, progress=progress,
             record_every=record_every, compiled=compiled, t_eval=t_eval, dense_output=dense_output,
         )  # fmt: skip
-    # The inputs, checked in this order (the first bad one is named), and the initial state.
+    # The inputs, checked one by one in this order (the first bad one raises); the state.
     spec = get_method(method)
     t0, t_end = initial.check_times(t0, t_end)
     h, rtol, given_atol = initial.check_steps(spec, h, rtol, atol)
@@ -234,13 +234,16 @@ def simulate(
     jumps = _jumps(stepper, impulses, t0, t_end)
     if control is not None and h is None:
         h = _first_step(body, Y, state, jumps, t0, t_end, rtol)
-    out = _march(stepper, state, (t0, t_end), events, progress, h=h, control=control,
-                 jumps=jumps, record_every=record_every, t_eval=times,
+    out = _march(stepper, state, (t0, t_end), h=h, control=control, jumps=jumps, events=events,
+                 record_every=record_every, progress=progress, t_eval=times,
                  dense_output=dense_output)  # fmt: skip
+    # The records as a Trajectory, ended at a first overflow.
     return _trajectory(out, stepper, spec, body, loads, settings)
 
 
-def _checked_loads(method: Method, forces, t0: float, t_end: float) -> tuple[list, list]:
+def _checked_loads(
+    method: Method, forces, t0: float, t_end: float
+) -> tuple[list[Load], list[Impulse]]:
     """``forces`` split into continuous loads and impulses (:func:`split_loads`), checked:
     none continuous for the exact flow, every impulse within the run."""
     loads, impulses = split_loads(forces)
@@ -317,10 +320,11 @@ def _first_step(body: RigidBody, Y, state, jumps: list[Jump], t0: float, t_end: 
     return min((end - t0) / 10, 0.1 * rtol ** (1 / 5) / omega)
 
 
-def _march(stepper: BodyStepper, state, t_span: tuple[float, float], events, progress: bool,
-           **options) -> Outcome:  # fmt: skip
-    """:func:`~tumble.ode.driver.march` with the users' events as the driver's, a progress bar
-    if asked, and ``options`` (h, control, jumps, …) as they are."""
+def _march(stepper: BodyStepper, state, t_span: tuple[float, float], *, h: float | None,
+           control: Control | None, jumps: list[Jump], events, record_every: int,
+           progress: bool, t_eval, dense_output: bool) -> Outcome:  # fmt: skip
+    """:func:`~tumble.ode.driver.march`, with the users' events as the driver's and a progress
+    bar if asked."""
     t0, t_end = t_span
     # A blow-up is detected and reported as status -1, not as numpy warnings on the way.
     with (
@@ -328,8 +332,10 @@ def _march(stepper: BodyStepper, state, t_span: tuple[float, float], events, pro
         np.errstate(over="ignore", invalid="ignore"),
     ):
         return march(
-            stepper, t_span, state, events=[stepper.event(event) for event in events],
-            progress=(lambda t: update(completed=t - t0)) if progress else None, **options,
+            stepper, t_span, state, h=h, control=control, jumps=jumps,
+            events=[stepper.event(event) for event in events], record_every=record_every,
+            progress=(lambda t: update(completed=t - t0)) if progress else None,
+            t_eval=t_eval, dense_output=dense_output,
         )  # fmt: skip
 
 
