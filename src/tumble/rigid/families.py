@@ -155,16 +155,17 @@ class ChartFamily:
     keeps : frozenset of str
         What the family keeps besides ``L`` (:data:`ON_SO3`, or nothing for a chart that
         leaves SO(3)).
-    adaptive : bool
+    compiled_adaptive : bool
         Whether the chart has a compiled adaptive loop (the error norm is the ``lie``
-        chart's, :func:`~tumble.rigid.charts.error_norm`).
+        chart's, :func:`~tumble.rigid.charts.error_norm`); without one an adaptive method
+        of the family steps in Python.
     columns : bool
         Whether the chart has structure-of-arrays batch loops (:mod:`tumble.rigid.soa`).
     """
 
     chart: Chart
     keeps: frozenset[str] = frozenset()
-    adaptive: bool = False
+    compiled_adaptive: bool = False
     columns: bool = False
     symplectic = False
     principal_frame = False
@@ -181,7 +182,7 @@ class ChartFamily:
         return ANGULAR_MOMENTUM | self.keeps
 
     def compiles(self, method: Method, kernel_loads: tuple | None) -> bool:
-        return kernel_loads is not None and (self.adaptive or not method.adaptive)
+        return kernel_loads is not None and (self.compiled_adaptive or not method.adaptive)
 
     def frame(self, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return _NO_FRAME

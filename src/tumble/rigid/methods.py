@@ -171,7 +171,7 @@ FAMILIES: dict[str, Family] = {
     for family in (
         ChartFamily(MATRIX),  # leaves SO(3)
         ChartFamily(QUAT, keeps=ON_SO3, columns=True),
-        ChartFamily(LIE, keeps=ON_SO3, adaptive=True, columns=True),
+        ChartFamily(LIE, keeps=ON_SO3, compiled_adaptive=True, columns=True),
         SplitFamily(),
     )
 }
