@@ -26,9 +26,8 @@ from tumble import _checks, so3
 from tumble._progress import announce_compilation
 from tumble.ode.control import fixed_step_count
 from tumble.ode.driver import Block, Grid, Status, Stepper, march, non_finite_message
-from tumble.rigid import geometric, initial, overflow
+from tumble.rigid import initial, overflow
 from tumble.rigid.body import RigidBody
-from tumble.rigid.charts import CHARTS
 from tumble.rigid.forces import (
     Impulse,
     Load,
@@ -37,7 +36,7 @@ from tumble.rigid.forces import (
     potential_energy,
     split_loads,
 )
-from tumble.rigid.methods import METHODS, Method, get_method
+from tumble.rigid.methods import FAMILIES, METHODS, Method, get_method
 from tumble.rigid.simulation import check_free, problem
 from tumble.rigid.steppers import unconverged_message
 from tumble.rigid.trajectory import Trajectory
@@ -470,7 +469,8 @@ class BatchStepper(Stepper):
     (time). A body whose state stops being finite stops alone: the block goes on for the
     others, and :attr:`counts` and :attr:`failed` say, per body, how many samples it
     recorded and at which step it stopped (-1: none); :attr:`causes` why
-    (:data:`~tumble.rigid._compiled.base.NON_FINITE` or ``UNCONVERGED``).
+    (:data:`~tumble.ode.contract.NON_FINITE` or ``UNCONVERGED``). The method's family
+    (:data:`~tumble.rigid.methods.FAMILIES`) gives the loop and the carried attitude:
     ``split`` methods carry ``R_p = R P`` with each body's principal axes ``P``.
     """
 
@@ -478,36 +478,20 @@ class BatchStepper(Stepper):
     time_axis = 1
 
     def __init__(self, method: Method, problem):
-        from tumble.rigid._compiled.charts import COMPILED
-        from tumble.rigid._compiled.flows import COMPILED_FLOWS
-
         self.method, self.problem = method, problem
-        self.split = method.family == "split"
-        if self.split:
-            assert method.flow is not None
-            self.batch = COMPILED_FLOWS[method.flow].batch
-        else:
-            self.chart = CHARTS[method.family]
-            self.batch = COMPILED[self.chart.name].batch
-        self._quat = method.family == "quat"
+        self.family = FAMILIES[method.family]
+        self.batch = self.family.batch_loop(method)
         self.counts = self.failed = self.causes = np.zeros(0, dtype=np.int64)
 
     def start(self, state: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """The stepped state for ``(R, Y)`` with a leading body axis."""
         R, Y = state
-        if self.split:
-            return R @ self.problem.axes, Y
-        return self.chart.attitude(R), Y
-
-    def _matrix(self, attitude: np.ndarray) -> np.ndarray:
-        if self.split:
-            return attitude @ np.swapaxes(self.problem.axes, -1, -2)
-        return self.chart.matrix(attitude)
+        return self.family.start(R, Y, self.problem.axes)
 
     def record(self, state) -> tuple:
         attitude, Y = state
-        q = attitude[:, None] if self._quat else np.empty((len(Y), 1, 0))
-        return self._matrix(attitude)[:, None], Y[:, None], q
+        q = attitude[:, None] if self.family.quaternion else np.empty((len(Y), 1, 0))
+        return self.family.matrix(attitude, self.problem.axes)[:, None], Y[:, None], q
 
     def march_block(self, state, grid: Grid, k0: int, k1: int, every: int, step0: int) -> Block:
         from tumble.rigid._compiled.base import Records
@@ -518,27 +502,24 @@ class BatchStepper(Stepper):
         records = Records(*(np.empty((n_bodies, size, *shape)) for shape in RECORD_SHAPES))
         self.counts, self.failed, self.causes = (np.zeros(n_bodies, dtype=np.int64)
                                                  for _ in range(3))  # fmt: skip
-        if self.split:
-            Z, RN = np.array(state[1], dtype=float), np.array(state[0], dtype=float)
-        else:
-            Z, RN = self.chart.pack(*state)
-        if self.method.family in SOA_FAMILIES and n_bodies >= SOA_MIN_BODIES:
-            _march_columns(self.method, self.problem, grid, Z, RN, every, records, self.counts,
-                           self.failed)  # fmt: skip
+        Z, RN = self.family.pack(*state)
+        if self.family.columns and n_bodies >= SOA_MIN_BODIES:
+            _march_columns(self.method, self.family.quaternion, self.problem, grid, Z, RN,
+                           every, records, self.counts, self.failed)  # fmt: skip
         else:
             announce_compilation(self.batch, f"the batch loop of {self.method.name}")
             self.batch(self.problem, grid, Z, RN, every, records, self.counts, self.failed,
                        self.causes)  # fmt: skip
-        q = records.q if self._quat else np.empty((n_bodies, size, 0))
+        q = records.q if self.family.quaternion else np.empty((n_bodies, size, 0))
         return Block(
             t=record_times(grid, every),
             records=(records.R, records.Y, q),
-            state=(RN, Z) if self.split else self.chart.read(Z, RN),
+            state=self.family.read(Z, RN),
         )
 
 
-SOA_FAMILIES = ("lie", "quat")
-"""The charts whose batches run in the structure-of-arrays loops of :mod:`tumble.rigid.soa`
+SOA_FAMILIES = tuple(name for name, family in FAMILIES.items() if family.columns)
+"""The families whose batches run in the structure-of-arrays loops of :mod:`tumble.rigid.soa`
 (bodies as columns, vectorised; the numbers of the one-body loop, bit for bit)."""
 
 SOA_MIN_BODIES = 32
@@ -548,14 +529,15 @@ more than the one-body loop (measured: one body 0.14× as fast in the columns, 1
 
 
 def _march_columns(
-    method: Method, problem, grid: Grid, Z, RN, every, records, counts, failed
+    method: Method, quaternion: bool, problem, grid: Grid, Z, RN, every, records, counts, failed
 ) -> None:
     """:func:`tumble.rigid.soa.run_batch` on the batch's state ``Z`` (N, nz), ``RN``
-    (N, 3, 3), updated in place (its blocks turn their bodies into columns and back)."""
+    (N, 3, 3), updated in place (its blocks turn their bodies into columns and back);
+    ``quaternion``: the chart carries q (else R)."""
     from tumble.rigid.soa import run_batch
 
     announce_compilation(run_batch, f"the batch loop of {method.name}")
-    run_batch(method.family == "quat", problem, grid, Z, RN, every, records, counts, failed)
+    run_batch(quaternion, problem, grid, Z, RN, every, records, counts, failed)
 
 
 RECORD_SHAPES = ((), (3, 3), (4,), (9,))
@@ -566,16 +548,17 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
     """Run the kernel for every body; lay the samples out as (body, time, …) arrays."""
     mass = _per_body(bodies, lambda body: body.mass)
     inv_I = _per_body(bodies, lambda body: body.inertia_inverse)
-    if spec.family == "split":  # each distinct body's principal frame, once
-        moments = _per_body(bodies, lambda body: geometric.principal_frame(body.inertia)[0])
-        axes = _per_body(bodies, lambda body: geometric.principal_frame(body.inertia)[1])
+    family = FAMILIES[spec.family]
+    if family.principal_frame:  # each distinct body's principal frame, once
+        moments = _per_body(bodies, lambda body: family.frame(body.inertia)[0])
+        axes = _per_body(bodies, lambda body: family.frame(body.inertia)[1])
     else:  # unused by the other loops: placeholders of the same (read-only) array type
         moments, axes = np.ones((len(bodies), 3)), np.tile(np.eye(3), (len(bodies), 1, 1))
         moments.setflags(write=False)
         axes.setflags(write=False)
     stepper = BatchStepper(spec, problem(spec, inv_I, mass, loads, axes, moments))
     out = march(stepper, (t0, t_end), stepper.start((R, Y)), h=h, record_every=every)
-    names = ("R", "Y", "q") if spec.family == "quat" else ("R", "Y")
+    names = ("R", "Y", "q") if family.quaternion else ("R", "Y")
     samples = dict(zip(names, out.records, strict=False))
     last = {
         name: record[:, 0] for name, record in zip(names, stepper.record(out.state), strict=False)

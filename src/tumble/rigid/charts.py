@@ -20,8 +20,9 @@ is Runge–Kutta–Munthe-Kaas (Munthe-Kaas 1998): the right-trivialised equatio
 
 A chart is Python data here (pack, map back, vector field) and a compiled twin in
 :mod:`tumble.rigid._compiled` (a numba field, map back and record), which a test checks
-against this reference to round-off. Adding a family costs one :class:`Chart`, its Python
-field, and its numba field.
+against this reference to round-off. Adding a chart family costs one :class:`Chart`, its
+Python field, its numba field, and its :class:`~tumble.rigid.families.ChartFamily` in
+:data:`tumble.rigid.methods.FAMILIES`.
 """
 
 from __future__ import annotations
@@ -64,7 +65,8 @@ class Chart:
     Attributes
     ----------
     name : str
-        ``"matrix"``, ``"quat"`` or ``"lie"``: a method's ``family``.
+        ``"matrix"``, ``"quat"`` or ``"lie"``: the name of the family that steps in it
+        (:data:`tumble.rigid.methods.FAMILIES`).
     size : int
         How many numbers of ``z`` carry the attitude.
     attitude : callable
@@ -86,6 +88,10 @@ class Chart:
         ``(K, z_new) -> f`` at the new state in its own chart from the last stage ``K[-1]``
         (``f(t + h, z_new)`` in the old chart) of a FSAL tableau; None where the chart
         cannot reuse it.
+    quaternion : bool
+        Whether the attitude carried is a quaternion, kept as the run's ``q`` record
+        (:attr:`Trajectory.q_raw <tumble.rigid.trajectory.Trajectory.q_raw>`, ``|q| − 1``
+        before normalising).
     """
 
     name: str
@@ -97,6 +103,7 @@ class Chart:
     read: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
     field: Callable[[Dynamics, bool, np.ndarray], Field]
     first_same_as_last: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
+    quaternion: bool = False
 
 
 def _identity(attitude: np.ndarray) -> np.ndarray:
@@ -347,6 +354,7 @@ QUAT = Chart(
     advance=lambda z, Rn: (z[:4].copy(), z[4:].copy()),
     read=lambda z, Rn: (z[..., :4].copy(), z[..., 4:].copy()),
     field=_quat_field,
+    quaternion=True,
 )
 LIE = Chart(
     name="lie",
@@ -361,4 +369,4 @@ LIE = Chart(
 )
 
 CHARTS: dict[str, Chart] = {chart.name: chart for chart in (MATRIX, QUAT, LIE)}
-"""Every chart by name: a method's ``family`` names one."""
+"""Every chart by name (each is a family of :data:`tumble.rigid.methods.FAMILIES`)."""

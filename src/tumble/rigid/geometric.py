@@ -204,6 +204,11 @@ FLOWS: dict[str, Callable[[np.ndarray, np.ndarray, np.ndarray, float], np.ndarra
 }
 """Each free-body flow by name: ``flow(R_p, L, moments, h) -> R_p`` (module docstring)."""
 
+ENERGY_FLOWS = frozenset({"midpoint", "dmv", "exact"})
+"""The flows that keep the free body's kinetic energy exactly (up to round-off and Newton's
+tolerance): a quadratic invariant of the midpoint rule, an integral of the Moser–Veselov
+map, the exact solution. ``axes`` keeps it only to ``O(h²)``, bounded over long runs."""
+
 
 def split_step(
     flow: Callable,

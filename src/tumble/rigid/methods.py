@@ -49,6 +49,11 @@ loads the energy error stays bounded over any number of steps, and ``midpoint-lp
 ``dmv`` and the three on the exact flow keep it exactly (a quadratic invariant of the
 midpoint rule; an integral of the Moser–Veselov map; the exact solution). With loads,
 ``split-axes`` is the Strang splitting on the axes flow, ``strang`` on the exact one.
+
+Each family is registered in :data:`FAMILIES` (:mod:`tumble.rigid.families`): it says which
+stepper runs its methods, in Python and compiled, what they record and keep, and how a batch
+runs them. A method is one line of :data:`METHODS`; a family of methods is one entry of
+:data:`FAMILIES` and the module that implements it.
 """
 
 from __future__ import annotations
@@ -65,6 +70,8 @@ from tumble.ode.tableaux import (
     RK4,
     ButcherTableau,
 )
+from tumble.rigid.charts import LIE, MATRIX, QUAT
+from tumble.rigid.families import ON_SO3, ChartFamily, Family, SplitFamily
 
 _CUBE_ROOT_2 = 2.0 ** (1.0 / 3.0)
 YOSHIDA4 = (
@@ -85,9 +92,10 @@ class Method:
     name : str
         The name ``simulate`` takes.
     family : {"matrix", "quat", "lie", "split"}
-        ``matrix``: the nine entries of R in the state; ``quat``: a quaternion, renormalised
-        after each step; ``lie``: RKMK in the local chart ``R = R_n exp(û)``; ``split``: a
-        splitting of kicks and a free-body flow (module docstring).
+        A name in :data:`FAMILIES`. ``matrix``: the nine entries of R in the state; ``quat``:
+        a quaternion, renormalised after each step; ``lie``: RKMK in the local chart
+        ``R = R_n exp(û)``; ``split``: a splitting of kicks and a free-body flow (module
+        docstring).
     tableau : ButcherTableau, optional
         The Runge–Kutta coefficients (the ODE core's); None for the ``split`` family.
     dexpinv : bool
@@ -133,33 +141,42 @@ class Method:
     def conserves(self) -> frozenset[str]:
         """The invariants kept to round-off on a torque-free body.
 
-        ``"angular_momentum"``: every method steps ``L̇ = τ`` linearly (or kicks it), so
-        without torque ``L`` is constant; ``"orthogonality"``: R stays a rotation (``lie``,
-        ``quat`` and ``split`` families, which never leave SO(3) or renormalise onto it);
+        Its family answers (:meth:`Family.conserves
+        <tumble.rigid.families.Family.conserves>`). ``"angular_momentum"``: every method
+        steps ``L̇ = τ`` linearly (or kicks it), so without torque ``L`` is constant;
+        ``"orthogonality"``: R stays a rotation (``lie``, ``quat`` and ``split`` families,
+        which never leave SO(3) or renormalise onto it);
         ``"casimir"``: the body momentum's norm ``|RᵀL| = |L|``, the Casimir of the
         Lie–Poisson equation (the same families: it follows from R staying a rotation);
         ``"energy"``: the kinetic energy of the free body (``midpoint-lp``, ``dmv`` and the
         methods on the exact flow). :mod:`tumble.report_card` measures each claim.
         """
-        kept = {"angular_momentum"}
-        if self.family in ("lie", "quat", "split"):
-            kept |= {"orthogonality", "casimir"}
-        if self.flow in ("midpoint", "dmv", "exact"):
-            kept.add("energy")
-        return frozenset(kept)
+        return FAMILIES[self.family].conserves(self)
 
     @property
     def symplectic(self) -> bool:
         """Whether the method is symplectic (and Poisson) on the rigid body: the ``split``
         family. Its energy error then stays bounded over long runs, without loads or with
         loads that derive from a potential (Hairer–Lubich–Wanner, ch. VI and IX)."""
-        return self.family == "split"
+        return FAMILIES[self.family].symplectic
 
     @property
     def adaptive(self) -> bool:
         """Whether the method chooses its own steps (an embedded pair)."""
         return self.tableau is not None and self.tableau.adaptive
 
+
+FAMILIES: dict[str, Family] = {
+    family.name: family
+    for family in (
+        ChartFamily(MATRIX),  # leaves SO(3)
+        ChartFamily(QUAT, keeps=ON_SO3, columns=True),
+        ChartFamily(LIE, keeps=ON_SO3, compiled_adaptive=True, columns=True),
+        SplitFamily(),
+    )
+}
+"""Every family of methods by name (:mod:`tumble.rigid.families`): a method's ``family``
+names one."""
 
 METHODS: dict[str, Method] = {
     method.name: method

@@ -12,8 +12,8 @@ from numpy.typing import ArrayLike
 
 from tumble import _checks
 from tumble._progress import progress_bar
-from tumble.ode.driver import Control, Jump, march
-from tumble.rigid import geometric, initial, overflow
+from tumble.ode.driver import Control, Jump, Outcome, march
+from tumble.rigid import initial, overflow
 from tumble.rigid.body import RigidBody
 from tumble.rigid.charts import Dynamics
 from tumble.rigid.forces import (
@@ -24,15 +24,9 @@ from tumble.rigid.forces import (
     potential_energy,
     split_loads,
 )
-from tumble.rigid.methods import Method, get_method
+from tumble.rigid.methods import FAMILIES, Method, get_method
 from tumble.rigid.pivot import centre_of_mass_motion, pivot_body, pivot_forces
-from tumble.rigid.steppers import (
-    BodyStepper,
-    CompiledSplitStepper,
-    CompiledStepper,
-    RigidStepper,
-    SplitStepper,
-)
+from tumble.rigid.steppers import BodyStepper
 from tumble.rigid.trajectory import Solution, Trajectory
 
 if TYPE_CHECKING:
@@ -41,24 +35,10 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 
-def _first_step(t_span: float, Y: np.ndarray, body: RigidBody, rtol: float) -> float:
-    with np.errstate(over="ignore"):  # a spin too large for doubles: a status, later
-        omega = np.linalg.norm(body.inertia_inverse @ Y[6:]) + 1e-12
-    return min(t_span / 10, 0.1 * rtol ** (1 / 5) / omega)
-
-
-def _jumps(stepper: BodyStepper, impulses, t0: float, t_end: float) -> list[Jump]:
-    """The impulses as the driver's jumps, one per distinct time in ``[t0, t_end]``."""
-    if not impulses:
-        return []
-    times = sorted({imp.time for imp in impulses if t0 <= imp.time <= t_end})
-    return [(time, stepper.kick([imp for imp in impulses if imp.time == time])) for time in times]
-
-
 def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> KernelProblem:
     """The kernels' :class:`~tumble.rigid._compiled.base.KernelProblem` for ``method`` and
-    constant ``loads`` (:func:`~tumble.rigid.forces.compiled_loads`); ``axes``, ``moments``
-    are the principal frame (``split`` methods; with a leading body axis in a batch)."""
+    constant ``loads`` (:func:`~tumble.rigid.forces.compiled_loads`); ``axes``, ``moments`` are the
+    principal frame (``split`` methods; with a leading body axis in a batch)."""
     from tumble.rigid._compiled.base import KernelProblem  # numba only for a compiled run
 
     if method.tableau is None:
@@ -68,16 +48,6 @@ def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> Kern
     F, tau, points, point_forces = loads
     return KernelProblem(method.dexpinv, A, b, inertia_inverse, mass, F, tau, points, point_forces,
                    axes, moments)  # fmt: skip
-
-
-def _check_impulse_times(forces, t0: float, t_end: float) -> None:
-    """Every impulse within the run: one outside it would be silently ignored."""
-    for index, item in enumerate(forces):
-        if isinstance(item, Impulse) and not t0 <= item.time <= t_end:
-            raise _checks.fail(
-                f"forces[{index}].time", item.time, f"within the run, [{t0!r}, {t_end!r}]", "s",
-                remedy="an impulse outside the run would never be applied",
-            )  # fmt: skip
 
 
 def check_free(method: Method, loads) -> None:
@@ -92,27 +62,15 @@ def check_free(method: Method, loads) -> None:
 
 
 def stepper_for(method: Method, body: RigidBody, loads, kernel_loads) -> BodyStepper:
-    """The method's stepper: compiled when ``kernel_loads`` (constant loads) are given."""
+    """The stepper of ``method``'s family (:data:`~tumble.rigid.methods.FAMILIES`): compiled
+    when ``kernel_loads`` (constant loads) are given, else the NumPy reference."""
+    family = FAMILIES[method.family]
     dynamics = Dynamics(body, loads)
-    if method.family == "split":
-        if kernel_loads is None:
-            return SplitStepper(method, dynamics)
-        moments, axes = geometric.principal_frame(body.inertia)
-        return CompiledSplitStepper(
-            method, dynamics,
-            problem(method, body.inertia_inverse, body.mass, kernel_loads, axes, moments),
-        )  # fmt: skip
     if kernel_loads is None:
-        return RigidStepper(method, dynamics)
-    return CompiledStepper(
-        method, dynamics,
-        problem(method, body.inertia_inverse, body.mass, kernel_loads, *_NO_PRINCIPAL_FRAME),
-    )  # fmt: skip
-
-
-_NO_PRINCIPAL_FRAME = (np.eye(3), np.ones(3))
-"""The kernels' ``axes`` and ``moments`` for the charts that do not use them (never written:
-built once, not at every call)."""
+        return family.stepper(method, dynamics, None)
+    moments, axes = family.frame(body.inertia)
+    kernel_problem = problem(method, body.inertia_inverse, body.mass, kernel_loads, axes, moments)
+    return family.stepper(method, dynamics, kernel_problem)
 
 
 def simulate(
@@ -249,83 +207,148 @@ def simulate(
     (11, True)
     """
     if pivot is not None:
-        if dense_output is not False:
-            raise _checks.fail("dense_output", dense_output, "False with a pivot",
-                               remedy="use t_eval to sample the run")  # fmt: skip
         return _about_pivot(
             body, t_end, pivot, method=method, h=h, rtol=rtol, atol=atol, t0=t0, x0=x0, v0=v0,
-            R0=R0, q0=q0, omega0=omega0, L0=L0, forces=forces, events=events,
-            progress=progress, record_every=record_every, compiled=compiled, t_eval=t_eval,
+            R0=R0, q0=q0, omega0=omega0, L0=L0, forces=forces, events=events, progress=progress,
+            record_every=record_every, compiled=compiled, t_eval=t_eval, dense_output=dense_output,
         )  # fmt: skip
+    # The inputs, checked one by one in this order (the first bad one raises); the state.
     spec = get_method(method)
     t0, t_end = initial.check_times(t0, t_end)
     h, rtol, given_atol = initial.check_steps(spec, h, rtol, atol)
     R, Y = initial.initial_state(body, x0, v0, R0, q0, omega0, L0)
     record_every = _checks.count("record_every", record_every)
     progress = _checks.flag("progress", progress)
-    loads, impulses = split_loads(forces)
-    check_free(spec, loads)
-    _check_impulse_times(forces, t0, t_end)
+    loads, impulses = _checked_loads(spec, forces, t0, t_end)
     events = _checks.callables("events", events, remedy="g(t, state) with state a State")
     dense_output = _checks.flag("dense_output", dense_output)
     times = None if t_eval is None else _checks.sample_times("t_eval", t_eval, t0, t_end)
-    tolerance = (
-        initial.tolerances(body, Y, t_end - t0, rtol, given_atol) if spec.adaptive else None
-    )
-    kernel_loads = compiled_loads(loads, body.mass)
-    plain = not events and times is None and not dense_output
-    use_kernel = kernel_loads is not None and plain and (not spec.adaptive or spec.family == "lie")
-    if compiled and not use_kernel:
+    control = _control(spec, body, Y, t_end - t0, rtol, given_atol)
+    # The stepper, from the method's family: compiled where its loop runs these loads.
+    plain = not events and times is None and not dense_output  # nothing only Python steps do
+    kernel_loads = _kernel_loads(spec, loads, body.mass, compiled, plain)
+    stepper = stepper_for(spec, body, loads, kernel_loads)
+    settings = _settings(h, rtol, control, record_every, compiled=kernel_loads is not None)
+    # The march, landing on every impulse.
+    state = stepper.start((R, Y))
+    jumps = _jumps(stepper, impulses, t0, t_end)
+    if control is not None and h is None:
+        h = _first_step(body, Y, state, jumps, t0, t_end, rtol)
+    out = _march(stepper, state, (t0, t_end), h=h, control=control, jumps=jumps, events=events,
+                 record_every=record_every, progress=progress, t_eval=times,
+                 dense_output=dense_output)  # fmt: skip
+    # The records as a Trajectory, ended at a first overflow.
+    return _trajectory(out, stepper, spec, body, loads, settings)
+
+
+def _checked_loads(
+    method: Method, forces, t0: float, t_end: float
+) -> tuple[list[Load], list[Impulse]]:
+    """``forces`` split into continuous loads and impulses (:func:`split_loads`), checked:
+    none continuous for the exact flow, every impulse within the run."""
+    loads, impulses = split_loads(forces)
+    check_free(method, loads)
+    _check_impulse_times(forces, t0, t_end)
+    return loads, impulses
+
+
+def _check_impulse_times(forces, t0: float, t_end: float) -> None:
+    """Every impulse within the run: one outside it would be silently ignored."""
+    for index, item in enumerate(forces):
+        if isinstance(item, Impulse) and not t0 <= item.time <= t_end:
+            raise _checks.fail(
+                f"forces[{index}].time", item.time, f"within the run, [{t0!r}, {t_end!r}]", "s",
+                remedy="an impulse outside the run would never be applied",
+            )  # fmt: skip
+
+
+def _control(method: Method, body: RigidBody, Y, span: float, rtol: float, atol) -> Control | None:
+    """An adaptive method's step control: ``rtol``, ``atol`` per part of ``Y``
+    (:func:`~tumble.rigid.initial.tolerances`), each step held to its share of the ``span``;
+    None for a fixed-step method."""
+    if not method.adaptive:
+        return None
+    return Control(rtol, initial.tolerances(body, Y, span, rtol, atol), horizon=span)
+
+
+def _kernel_loads(method: Method, loads, mass: float, compiled: bool | None, plain: bool):
+    """The loads as the compiled loops take them (:func:`compiled_loads`), or None to step in
+    Python.
+
+    A compiled loop runs when the loads are constants, the family has a loop for the method
+    (:meth:`~tumble.rigid.families.Family.compiles`) and the run asks nothing only the Python
+    steps give (``plain``: no events, ``t_eval`` or dense output); ``compiled`` forces
+    (True: a ValueError where none runs) or forbids (False) it.
+    """
+    kernel_loads = compiled_loads(loads, mass)
+    runs = plain and FAMILIES[method.family].compiles(method, kernel_loads)
+    if compiled and not runs:
         raise _checks.fail(
             "compiled", compiled, "False or None here",
             remedy="the compiled kernels need constant loads and no events, t_eval or dense "
             "output (and a fixed-step or a lie method)",
         )  # fmt: skip
-    use_kernel = use_kernel if compiled is None else bool(compiled)
-    stepper = stepper_for(spec, body, loads, kernel_loads if use_kernel else None)
-    settings = {
-        "h": h,
-        "rtol": rtol or None,
-        "atol": None if tolerance is None else tolerance.tolist(),
-        "record_every": record_every,
-        "compiled": use_kernel,
-    }
-    state = stepper.start((R, Y))
-    jumps = _jumps(stepper, impulses, t0, t_end)
-    control = None
-    if spec.adaptive:
-        assert tolerance is not None
-        control = Control(rtol, tolerance, horizon=t_end - t0)
-        if h is None:
-            first = [apply for time, apply in jumps if time == t0]
-            Y_first = first[0](state)[1] if first else Y
-            end = min([time for time, _ in jumps if time > t0] + [t_end])
-            h = _first_step(end - t0, Y_first, body, rtol)
+    return kernel_loads if (runs if compiled is None else compiled) else None
+
+
+def _settings(h, rtol: float, control: Control | None, record_every: int, compiled: bool) -> dict:
+    """The run's settings as :attr:`Trajectory.settings
+    <tumble.rigid.trajectory.Trajectory.settings>` keeps them (``h`` as given)."""
+    atol = None if control is None else np.asarray(control.atol).tolist()
+    return {"h": h, "rtol": rtol or None, "atol": atol, "record_every": record_every,
+            "compiled": compiled}  # fmt: skip
+
+
+def _jumps(stepper: BodyStepper, impulses, t0: float, t_end: float) -> list[Jump]:
+    """The impulses as the driver's jumps, one per distinct time in ``[t0, t_end]``."""
+    if not impulses:
+        return []
+    times = sorted({imp.time for imp in impulses if t0 <= imp.time <= t_end})
+    return [(time, stepper.kick([imp for imp in impulses if imp.time == time])) for time in times]
+
+
+def _first_step(body: RigidBody, Y, state, jumps: list[Jump], t0: float, t_end: float,
+                rtol: float) -> float:  # fmt: skip
+    """An adaptive run's first step when ``h`` is not given: ``0.1 rtol^(1/5) / |ω|`` with ω
+    after the impulses at ``t0``, at most a tenth of the way to the first later impulse (or
+    the end)."""
+    first = [apply for time, apply in jumps if time == t0]
+    Y_first = first[0](state)[1] if first else Y
+    end = min([time for time, _ in jumps if time > t0] + [t_end])
+    with np.errstate(over="ignore"):  # a spin too large for doubles: a status, later
+        omega = np.linalg.norm(body.inertia_inverse @ Y_first[6:]) + 1e-12
+    return min((end - t0) / 10, 0.1 * rtol ** (1 / 5) / omega)
+
+
+def _march(stepper: BodyStepper, state, t_span: tuple[float, float], *, h: float | None,
+           control: Control | None, jumps: list[Jump], events, record_every: int,
+           progress: bool, t_eval, dense_output: bool) -> Outcome:  # fmt: skip
+    """:func:`~tumble.ode.driver.march`, with the users' events as the driver's and a progress
+    bar if asked."""
+    t0, t_end = t_span
     # A blow-up is detected and reported as status -1, not as numpy warnings on the way.
     with (
         progress_bar(progress, t_end - t0, "simulating") as update,
         np.errstate(over="ignore", invalid="ignore"),
     ):
-        out = march(
-            stepper,
-            (t0, t_end),
-            state,
-            h=h,
-            control=control,
-            events=[stepper.event(event) for event in events],
-            jumps=jumps,
-            record_every=record_every,
+        return march(
+            stepper, t_span, state, h=h, control=control, jumps=jumps,
+            events=[stepper.event(event) for event in events], record_every=record_every,
             progress=(lambda t: update(completed=t - t0)) if progress else None,
-            t_eval=times,
-            dense_output=dense_output,
-        )
+            t_eval=t_eval, dense_output=dense_output,
+        )  # fmt: skip
+
+
+def _trajectory(out: Outcome, stepper: BodyStepper, method: Method, body: RigidBody, loads,
+                settings: dict) -> Trajectory:  # fmt: skip
+    """The driver's outcome as a :class:`Trajectory`, ended at its first record that
+    overflows (:func:`tumble.rigid.overflow.checked`)."""
     if not out.status.success:
         log.warning("simulate stopped early: %s", out.message)
     R_samples, Y_samples, q_samples = out.records
     sol = None
     if out.step_times is not None and out.interpolants is not None:
         sol = Solution(stepper, out.step_times, out.interpolants)
-    V = potential_energy(loads, Y_samples[:, :3], R_samples, body.mass)
     run = Trajectory(
         t=out.t,
         x=Y_samples[:, :3],
@@ -333,18 +356,18 @@ def simulate(
         R=R_samples,
         L_world=Y_samples[:, 6:],
         body=body,
-        method=spec.name,
+        method=method.name,
         settings=settings,
         status=out.status,
         message=out.message,
         n_steps=out.n_steps,
         n_rejected=out.n_rejected,
         t_events=[np.array(ts, dtype=float) for ts in out.t_events],
-        q_raw=q_samples if spec.family == "quat" else None,
-        potential_energy=V,
+        q_raw=q_samples if FAMILIES[method.family].quaternion else None,
+        potential_energy=potential_energy(loads, Y_samples[:, :3], R_samples, body.mass),
         sol=sol,
     )
-    attitudes = None if "orthogonality" in spec.conserves else R_samples  # R may leave SO(3)
+    attitudes = None if "orthogonality" in method.conserves else R_samples  # may leave SO(3)
     run = overflow.checked(run, Y_samples, attitudes, any(load.conservative for load in loads))
     if not run.status.success and out.status.success:
         log.warning("simulate stopped: %s", run.message)
@@ -352,8 +375,11 @@ def simulate(
 
 
 def _about_pivot(body: RigidBody, t_end: float, pivot: ArrayLike, *, x0, v0, R0, q0, forces,
-                 **options) -> Trajectory:  # fmt: skip
+                 dense_output, **options) -> Trajectory:  # fmt: skip
     """``simulate`` with ``pivot``: the reduced body about it (:mod:`tumble.rigid.pivot`)."""
+    if dense_output is not False:
+        raise _checks.fail("dense_output", dense_output, "False with a pivot",
+                           remedy="use t_eval to sample the run")  # fmt: skip
     if not isinstance(body, RigidBody):
         raise _checks.fail("body", body, "a tumble.RigidBody")
     point = _checks.array("pivot", pivot, shape=(3,), unit="m")

@@ -8,7 +8,7 @@ round-off. Both plug into :func:`tumble.ode.driver.march`, which owns the time l
 
 :class:`SplitStepper` and :class:`CompiledSplitStepper` are the same pair for the ``split``
 family: one step of :func:`~tumble.rigid.geometric.split_step` in NumPy, and its compiled
-loop.
+loop. The method's family (:mod:`tumble.rigid.families`) chooses and builds them.
 
 The stepped state is ``(attitude, Y)``: the chart's attitude (R, or q for the ``quat`` chart,
 or ``R_p = R P`` in the principal frame for the ``split`` family) and ``Y = (x, p, L)``,
@@ -18,6 +18,7 @@ shape (9,).
 from __future__ import annotations
 
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -28,9 +29,11 @@ from tumble.ode.dense import StepInterpolant, step_coefficients
 from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Stepper, non_finite_message
 from tumble.ode.stepper import rk_step
 from tumble.rigid import geometric
-from tumble.rigid.charts import CHARTS, LIE, Dynamics, error_norm, separatrix_form
+from tumble.rigid.charts import LIE, Chart, Dynamics, error_norm, separatrix_form
 from tumble.rigid.forces import State
-from tumble.rigid.methods import Method
+
+if TYPE_CHECKING:  # methods.py registers the families, which build these steppers
+    from tumble.rigid.methods import Method
 
 RigidState = tuple[np.ndarray, np.ndarray]
 """``(attitude, Y)``: the chart's attitude and ``(x, p, L)``."""
@@ -84,15 +87,14 @@ class BodyStepper(Stepper):
 
 
 class RigidStepper(BodyStepper):
-    """One step of ``method`` on ``dynamics``: its tableau in its chart (NumPy)."""
+    """One step of ``method`` on ``dynamics``: its tableau in ``chart``, its family's (NumPy)."""
 
-    def __init__(self, method: Method, dynamics: Dynamics):
+    def __init__(self, method: Method, chart: Chart, dynamics: Dynamics):
         assert method.tableau is not None
-        self.method, self.dynamics = method, dynamics
-        self.chart = CHARTS[method.family]
+        self.method, self.chart, self.dynamics = method, chart, dynamics
         self.adaptive = method.adaptive
         self.error_order = method.tableau.error_order
-        self._quat = self.chart.name == "quat"
+        self._quat = chart.quaternion
         self._last: tuple = ()  # the last step's field, z, base point, stages, z_new and h
         self._fsal = method.tableau.fsal and self.chart.first_same_as_last is not None
         self._first: tuple = (None, None)  # (accepted state, its first stage) with FSAL
@@ -225,10 +227,10 @@ class CompiledStepper(RigidStepper):
 
     blocks = True
 
-    def __init__(self, method: Method, dynamics: Dynamics, problem):
+    def __init__(self, method: Method, chart: Chart, dynamics: Dynamics, problem):
         from tumble.rigid._compiled.charts import COMPILED
 
-        super().__init__(method, dynamics)
+        super().__init__(method, chart, dynamics)
         self.problem, self.loop = problem, COMPILED[self.chart.name].loop
         self.adaptive_loop = COMPILED[self.chart.name].adaptive
         self.adaptive_blocks = method.adaptive and self.adaptive_loop is not None
