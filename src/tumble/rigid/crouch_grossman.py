@@ -36,6 +36,9 @@ References
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from tumble import so3
@@ -43,8 +46,11 @@ from tumble._progress import announce_compilation
 from tumble.ode.driver import Block, Grid
 from tumble.ode.tableaux import ButcherTableau
 from tumble.rigid.charts import Dynamics
-from tumble.rigid.methods import Method
+from tumble.rigid.families import ANGULAR_MOMENTUM, ON_SO3
 from tumble.rigid.steppers import BodyStepper, RigidState, _records
+
+if TYPE_CHECKING:
+    from tumble.rigid.methods import Method
 
 CG3 = ButcherTableau(
     name="cg3",
@@ -145,3 +151,47 @@ class CompiledCrouchGrossmanStepper(CrouchGrossmanStepper):
             state=(R, Y),
             failed=failed,
         )
+
+
+class CrouchGrossmanFamily:
+    """The Crouch–Grossman methods as a family (:class:`~tumble.rigid.families.Family`): the
+    attitude is R itself, every stage and step a product of rotations, so R stays on SO(3)
+    and with it the Casimir ``|RᵀL|``; not symplectic. Compiled for constant loads at fixed
+    steps (none is adaptive); a batch runs one body per thread."""
+
+    name = "cg"
+    symplectic = False
+    quaternion = False
+    principal_frame = False
+    columns = False
+
+    def conserves(self, method: Method) -> frozenset[str]:
+        return ANGULAR_MOMENTUM | ON_SO3
+
+    def compiles(self, method: Method, kernel_loads: tuple | None) -> bool:
+        return kernel_loads is not None and not method.adaptive
+
+    def frame(self, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return np.ones(3), np.eye(3)
+
+    def stepper(self, method: Method, dynamics: Dynamics, problem: Any) -> BodyStepper:
+        if problem is None:
+            return CrouchGrossmanStepper(method, dynamics)
+        return CompiledCrouchGrossmanStepper(method, dynamics, problem)
+
+    def batch_loop(self, method: Method) -> Callable[..., None]:
+        from tumble.rigid._compiled.crouch_grossman import COMPILED_CG
+
+        return COMPILED_CG.batch
+
+    def start(self, R: np.ndarray, Y: np.ndarray, axes: np.ndarray) -> RigidState:
+        return R, Y
+
+    def matrix(self, attitude: np.ndarray, axes: np.ndarray) -> np.ndarray:
+        return attitude
+
+    def pack(self, attitude: np.ndarray, Y: np.ndarray) -> RigidState:
+        return np.array(Y, dtype=float), np.array(attitude, dtype=float)
+
+    def read(self, Z: np.ndarray, RN: np.ndarray) -> RigidState:
+        return RN, Z

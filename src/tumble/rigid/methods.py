@@ -50,6 +50,18 @@ loads the energy error stays bounded over any number of steps, and ``midpoint-lp
 midpoint rule; an integral of the Moser–Veselov map; the exact solution). With loads,
 ``split-axes`` is the Strang splitting on the axes flow, ``strang`` on the exact one.
 
+The Crouch–Grossman methods (family ``cg``, :mod:`tumble.rigid.crouch_grossman`) compose
+the stages' rotations instead of adding their slopes, so every stage stays on SO(3) with no
+``dexp⁻¹``:
+
+======================  ========  ==========  =================================================
+name                    family    tableau     what it is
+======================  ========  ==========  =================================================
+``cg3``                 cg        CG3         Crouch & Grossman (1993): 3 stages, order 3
+``cg4``                 cg        CG4         Jackiewicz, Marthinsen & Owren (2000): 5
+                                              stages, order 4
+======================  ========  ==========  =================================================
+
 Each family is registered in :data:`FAMILIES` (:mod:`tumble.rigid.families`): it says which
 stepper runs its methods, in Python and compiled, what they record and keep, and how a batch
 runs them. A method is one line of :data:`METHODS`; a family of methods is one entry of
@@ -71,6 +83,7 @@ from tumble.ode.tableaux import (
     ButcherTableau,
 )
 from tumble.rigid.charts import LIE, MATRIX, QUAT
+from tumble.rigid.crouch_grossman import CG3, CG4, CrouchGrossmanFamily
 from tumble.rigid.families import ON_SO3, ChartFamily, Family, SplitFamily
 
 _CUBE_ROOT_2 = 2.0 ** (1.0 / 3.0)
@@ -91,7 +104,7 @@ class Method:
     ----------
     name : str
         The name ``simulate`` takes.
-    family : {"matrix", "quat", "lie", "split"}
+    family : {"matrix", "quat", "lie", "split", "cg"}
         A name in :data:`FAMILIES`. ``matrix``: the nine entries of R in the state; ``quat``:
         a quaternion, renormalised after each step; ``lie``: RKMK in the local chart
         ``R = R_n exp(û)``; ``split``: a splitting of kicks and a free-body flow (module
@@ -173,6 +186,7 @@ FAMILIES: dict[str, Family] = {
         ChartFamily(QUAT, keeps=ON_SO3, columns=True),
         ChartFamily(LIE, keeps=ON_SO3, compiled_adaptive=True, columns=True),
         SplitFamily(),
+        CrouchGrossmanFamily(),
     )
 }
 """Every family of methods by name (:mod:`tumble.rigid.families`): a method's ``family``
@@ -198,6 +212,8 @@ METHODS: dict[str, Method] = {
         Method("exact", "split", flow="exact"),
         Method("strang", "split", flow="exact", order_override=2),
         Method("yoshida4", "split", flow="exact", weights=YOSHIDA4, order_override=4),
+        Method("cg3", "cg", CG3),
+        Method("cg4", "cg", CG4),
     )
 }
 """Every rigid-body method by name."""
