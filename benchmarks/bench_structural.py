@@ -156,7 +156,7 @@ def sparse_product(system) -> float:
 
 def scipy_banded_solve(system, dt: float) -> tuple:
     """One ``cho_solve_banded`` with the Newmark step matrix's band factor [s]."""
-    A = structural.NEWMARK.matrix(system, None, dt).tocsr()
+    A = structural.NEWMARK.matrices(system, None, dt)[0].tocsr()
     b = bandwidth(A)
     band = np.zeros((b + 1, system.n_dofs))
     for k in range(b + 1):
@@ -254,7 +254,7 @@ def newmark_table(sizes, ops, repeat: int) -> tuple[list[str], list[str]]:
 def floor_breakdown(system, dt: float, floor: tuple) -> str:
     """Why a step costs more than 3 S·x: its parts timed alone, and its working set."""
     try:
-        factor = banded_cholesky(structural.NEWMARK.matrix(system, None, dt))
+        factor = banded_cholesky(structural.NEWMARK.matrices(system, None, dt)[0])
     except np.linalg.LinAlgError:
         return "  - why: the banded Cholesky broke down; tumble stepped with SuperLU"
     arrays = system.elements.kernel_arrays
