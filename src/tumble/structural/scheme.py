@@ -19,8 +19,9 @@ member                      what it gives
 ``coefficients(dt)``        the numbers its step reads (``Δt`` first)
 ``start(…)``                its stepped state from ``(x₀, y₀)``
 ``step(…)``                 one step in NumPy, in place: the reference
-``kernel``                  the same step compiled (a :class:`~tumble.structural.kernels.
-                            StepKernel`), bound into the one time loop
+``kernel``                  the same step compiled (a
+                            :class:`~tumble.structural.kernels.StepKernel`), bound
+                            into the one time loop
 ``amplification_matrix(Ω)`` ``G`` of one mode, ``zⁿ⁺¹ = G zⁿ``
 ``critical_omega()``        the largest stable ``Ω = ωΔt`` (0: never, ``inf``: always)
 =========================== ============================================================
@@ -73,9 +74,9 @@ class Scheme(ABC):
     order : int
         Its declared order of accuracy.
     carries_acceleration : bool
-        Whether it starts from ``a₀ = M⁻¹ r₀`` (:func:`~tumble.structural.stepping.
-        initial_state`): its first steps move ``x`` by ``Δt² a₀`` terms, and the energy
-        watch counts ``½ Δt² a₀ᵀM a₀`` in ``V₀``.
+        Whether it starts from ``a₀ = M⁻¹ r₀``
+        (:func:`~tumble.structural.stepping.initial_state`): its first steps move ``x`` by
+        ``Δt² a₀`` terms, and the energy watch counts ``½ Δt² a₀ᵀM a₀`` in ``V₀``.
     kernel : StepKernel
         Its compiled step, bound into the one time loop.
     """

@@ -1,9 +1,9 @@
 """How a scheme is stepped, twice: a NumPy reference and the one compiled loop.
 
-Every scheme of :data:`tumble.structural.SCHEMES` is a :class:`~tumble.structural.scheme.
-Scheme`: constant step matrices, factorised once, and a step that updates a
-:class:`BeamState` in place. The state carries the out-of-balance force ``q = f − S x``,
-updated by ``S Δx`` summed element by element
+Every scheme of :data:`tumble.structural.SCHEMES` is a
+:class:`~tumble.structural.scheme.Scheme`: constant step matrices, factorised once, and a
+step that updates a :class:`BeamState` in place. The state carries the out-of-balance force
+``q = f − S x``, updated by ``S Δx`` summed element by element
 (:meth:`~tumble.structural.system.LinearSystem.internal_forces`) and never formed as
 ``f − S x`` from the global matrix: on fine meshes (``κ(S) ∝ N⁴``) that is a difference of
 huge numbers, and carrying the small ``q`` rounds it relative to its own size.
@@ -11,13 +11,13 @@ huge numbers, and carrying the small ``q`` rounds it relative to its own size.
 Two steppers of the one driver, :func:`tumble.ode.driver.march` (which owns the run), take
 any scheme:
 
-- :class:`ReferenceBeamStepper` runs the scheme's NumPy step (:meth:`~tumble.structural.
-  scheme.Scheme.step`) with SuperLU (:func:`~tumble.structural.factorization.factorize`),
-  one Python call a step;
-- :class:`CompiledBeamStepper` runs its compiled twin (:attr:`~tumble.structural.scheme.
-  Scheme.kernel`) inside the one time loop (:func:`tumble.structural.kernels.time_loop`) with
-  the banded Cholesky of :class:`~tumble.structural.factorization.BandedCholesky`, many
-  steps per call.
+- :class:`ReferenceBeamStepper` runs the scheme's NumPy step
+  (:meth:`~tumble.structural.scheme.Scheme.step`) with SuperLU
+  (:func:`~tumble.structural.factorization.factorize`), one Python call a step;
+- :class:`CompiledBeamStepper` runs its compiled twin
+  (:attr:`~tumble.structural.scheme.Scheme.kernel`) inside the one time loop
+  (:func:`tumble.structural.kernels.time_loop`) with the banded Cholesky of
+  :class:`~tumble.structural.factorization.BandedCholesky`, many steps per call.
 
 Both watch the energy (:mod:`tumble.structural.divergence`) every
 :data:`~tumble.structural.divergence.CHECK_EVERY` steps; tests check that the two agree to
