@@ -114,8 +114,14 @@ def test_long_stable_runs_never_fail_the_check(beam, scheme, steps_per_period):
     damping = structural.RayleighDamping.from_damping_ratio(0.02, *omega)
     run = structural.integrate(beam, scheme, dt, n_steps=5000, damping=damping, record_every=7)
     assert run.status == Status.SUCCESS, run.message
-    # measured at most 0.077 (from rest the bound is loose); 1e6 is where the check fires
-    assert np.max(mechanical_energy(beam, run)[1:] / bound(beam, run)[1:]) < 10
+    # From the first check on (step 64), what the check sees: measured at most 0.029 (from
+    # rest the bound is loose); 1e6 is where the check fires. Before it a scheme may
+    # overshoot: Wilson-θ's displacement after one step from a₀ grows as Ω² (module
+    # tumble.structural.wilson), 2e8 B at step 1 and 2.1e5 at step 7 at 0.3 steps a period
+    # (ωΔt up to 1e4), which ρ∞ = 0.78 a step takes to 7e-9 by step 64 (the others: 0.078
+    # at most from step 7 on).
+    checked = run.t >= divergence.CHECK_EVERY * dt * (1 - 1e-12)
+    assert np.max(mechanical_energy(beam, run)[checked] / bound(beam, run)[checked]) < 10
 
 
 @pytest.mark.parametrize(
