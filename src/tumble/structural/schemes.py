@@ -8,7 +8,8 @@ each family lives in one module:
   ``explicit``, ``semi-implicit``, ``implicit``, ``midpoint``) and ``newmark``
   (:class:`Newmark`, average acceleration by default);
 - :mod:`~tumble.structural.alpha`: ``hht``, ``generalized-alpha`` (by ρ∞) and ``bathe``
-  (the ρ∞-Bathe composite), with controllable numerical damping.
+  (the ρ∞-Bathe composite), with controllable numerical damping;
+- :mod:`~tumble.structural.wilson`: ``wilson`` (Wilson-θ, θ = 1.4 by default).
 
 :data:`SCHEMES` is the one list of them: the tests, ``tumble stability --analyse``, the
 report card and the docs iterate over it, and nothing else names a scheme class. Adding a
@@ -62,6 +63,7 @@ from tumble.structural.stepping import (
     initial_state,
 )
 from tumble.structural.system import LinearSystem, RayleighDamping
+from tumble.structural.wilson import WilsonTheta
 
 PROGRESS_UPDATES = 200
 """A progress bar is advanced about this many times per run."""
@@ -81,13 +83,13 @@ BATHE = Bathe()
 SCHEMES: dict[str, Scheme] = {
     s.name: s
     for s in (EXPLICIT, SEMI_IMPLICIT, IMPLICIT, MIDPOINT, NEWMARK, HHT_ALPHA, GENERALIZED_ALPHA,
-              BATHE)
+              BATHE, WilsonTheta())
 }  # fmt: skip
 """The schemes by name, with their default parameters: ``newmark`` β = ¼, γ = ½; ``hht``
-α = −0.05; ``generalized-alpha`` ρ∞ = 0.8; ``bathe`` ρ∞ = 0 (the original Bathe method).
-Pass :class:`Newmark`, :class:`~tumble.structural.alpha.HHT`,
-:class:`~tumble.structural.alpha.GeneralizedAlpha` or :class:`~tumble.structural.alpha.Bathe`
-to change them."""
+α = −0.05; ``generalized-alpha`` ρ∞ = 0.8; ``bathe`` ρ∞ = 0 (the original Bathe method);
+``wilson`` θ = 1.4. Pass :class:`Newmark`, :class:`~tumble.structural.alpha.HHT`,
+:class:`~tumble.structural.alpha.GeneralizedAlpha`, :class:`~tumble.structural.alpha.Bathe`
+or :class:`~tumble.structural.wilson.WilsonTheta` to change them."""
 
 SEED_SCHEMES = ("explicit", "semi-implicit", "implicit", "midpoint")
 """The four schemes of seed 003, in its order."""
@@ -184,9 +186,10 @@ def integrate(
         From :func:`~tumble.structural.cantilever` or :func:`~tumble.structural.build_frame`.
     scheme : str or scheme object
         A name from :data:`SCHEMES` (``"explicit"``, ``"semi-implicit"``, ``"implicit"``,
-        ``"midpoint"``, ``"newmark"``, ``"hht"``, ``"generalized-alpha"``, ``"bathe"``), or
-        a scheme with its parameters, e.g. ``Newmark(beta=0.3025, gamma=0.6)``,
-        ``GeneralizedAlpha(rho_inf=0.5)`` (:mod:`tumble.structural.alpha`).
+        ``"midpoint"``, ``"newmark"``, ``"hht"``, ``"generalized-alpha"``, ``"bathe"``,
+        ``"wilson"``), or a scheme with its parameters, e.g.
+        ``Newmark(beta=0.3025, gamma=0.6)``, ``GeneralizedAlpha(rho_inf=0.5)``
+        (:mod:`tumble.structural.alpha`), ``WilsonTheta(theta=1.5)``.
     dt : float
         Time step [s], > 0.
     n_steps, t_end : int or float
