@@ -22,11 +22,12 @@ elements, in two versions: with the axial DOFs (3 per node, the general frame; 3
    Δt = 0.02 · 2/ω_max so the explicit scheme stays finite over the timed steps.
 3. The explicit scheme started from rest under the step load, whose state fills with
    subnormal numbers far from the tip (SPEC §3.7): their count and the cost per step.
-4. ``hht`` (α = −0.05), ``generalized-alpha`` (ρ∞ = 0.8) and ``bathe`` (ρ∞ = 0) against
-   ``newmark`` on the bending-only beam from rest under the step load, Δt = T₁/200, each
-   pair of runs timed beside a pair of ``newmark`` runs (targets, issue 16: ≤ 1.3×, Bathe's
-   two sub-steps ≤ 2.6×), and OpenSeesPy's ``GeneralizedAlpha`` (αM = (2 − ρ∞)/(1 + ρ∞),
-   αF = 1/(1 + ρ∞), its convention) and ``HHT`` (1 + α) integrators on the same beam.
+4. ``hht`` (α = −0.05), ``generalized-alpha`` (ρ∞ = 0.8), ``bathe`` (ρ∞ = 0) and ``wilson``
+   (θ = 1.4) against ``newmark`` on the bending-only beam from rest under the step load,
+   Δt = T₁/200, each pair of runs timed beside a pair of ``newmark`` runs (targets, issue 16:
+   ≤ 1.3×, Bathe's two sub-steps ≤ 2.6×; Wilson-θ ≤ 1.3×), and OpenSeesPy's
+   ``GeneralizedAlpha`` (αM = (2 − ρ∞)/(1 + ρ∞), αF = 1/(1 + ρ∞), its convention) and
+   ``HHT`` (1 + α) integrators on the same beam.
 
 A step's cost is ``(T(n₂) − T(n₁)) / (n₂ − n₁)`` of whole runs (setup and factorisation
 cancel), repeated; tables give the median and (min–max). BLAS runs single-threaded
@@ -66,8 +67,9 @@ PEER_TARGET = 10.0
 """And be at least this many times faster than OpenSeesPy."""
 TARGET_SIZES = (10_000, 100_000)
 OTHER_SCHEMES = ("explicit", "semi-implicit", "implicit", "midpoint")
-FAMILY = {"hht": 1.3, "generalized-alpha": 1.3, "bathe": 2.6}
-"""The damped schemes and their per-step targets relative to ``newmark`` (issue 16)."""
+FAMILY = {"hht": 1.3, "generalized-alpha": 1.3, "bathe": 2.6, "wilson": 1.3}
+"""The damped schemes and their per-step targets relative to ``newmark`` (issue 16; Wilson-θ,
+issue 25, a Newmark step plus vector updates like HHT)."""
 FAMILY_SIZES = (1000, 10_000)
 OPENSEES_FAMILY = {
     "hht": ("HHT", 0.95),
@@ -156,7 +158,7 @@ def sparse_product(system) -> float:
 
 def scipy_banded_solve(system, dt: float) -> tuple:
     """One ``cho_solve_banded`` with the Newmark step matrix's band factor [s]."""
-    A = structural.NEWMARK.matrix(system, None, dt).tocsr()
+    A = structural.NEWMARK.matrices(system, None, dt)[0].tocsr()
     b = bandwidth(A)
     band = np.zeros((b + 1, system.n_dofs))
     for k in range(b + 1):
@@ -254,7 +256,7 @@ def newmark_table(sizes, ops, repeat: int) -> tuple[list[str], list[str]]:
 def floor_breakdown(system, dt: float, floor: tuple) -> str:
     """Why a step costs more than 3 S·x: its parts timed alone, and its working set."""
     try:
-        factor = banded_cholesky(structural.NEWMARK.matrix(system, None, dt))
+        factor = banded_cholesky(structural.NEWMARK.matrices(system, None, dt)[0])
     except np.linalg.LinAlgError:
         return "  - why: the banded Cholesky broke down; tumble stepped with SuperLU"
     arrays = system.elements.kernel_arrays

@@ -313,8 +313,10 @@ def _analyse_steps(n_elements: int, dt: float | None, folder: Path, force: bool)
     table, step = analysis.table, analysis.dt
     for name, values in (("algorithmic damping ratio ξ̄", table.damping_ratio),
                          ("period elongation (T̄ − T)/T", table.period_elongation)):  # fmt: skip
+        # one space between the columns: every scheme of SCHEMES fits in 80 columns
         grid = Table(title=f"{name}, cantilever with {n_elements} elements, Δt = {step:.4g} s "
-                     "(—: no period, the mode is damped out within a step)", box=None)  # fmt: skip
+                     "(—: no period, the mode is damped out within a step)", box=None,
+                     collapse_padding=True, pad_edge=False)  # fmt: skip
         for column in ("mode", "ω [rad/s]", "Ω = ωΔt", *table.schemes):
             grid.add_column(column.replace("-", "- "), justify="right", overflow="fold")
         for k, w in enumerate(table.omega):

@@ -6,8 +6,8 @@ from structural_frames import shuffled_cantilever, tilted_frame, wheel
 
 from tumble import structural
 from tumble.ode import Status
-from tumble.structural import stepping
 from tumble.structural.factorization import MAX_BANDWIDTH
+from tumble.structural.increments import Increments
 
 STEEL = {"E": 210e9, "rho": 7850.0, "width": 0.01, "height": 0.01}
 STEPS = 300
@@ -132,7 +132,7 @@ def test_compiled_true_refuses_a_band_wider_than_the_kernel_takes():
 )
 def test_schemes_as_increment_constants(scheme, k_g, k_dy, k_sa, k_a):
     dt = 0.01
-    expected = stepping.Increments(dt, k_g * dt, k_dy * dt, k_sa * dt**2, k_a * dt**2)
+    expected = Increments(dt, k_g * dt, k_dy * dt, k_sa * dt**2, k_a * dt**2)
     assert structural.SCHEMES[scheme].increments(dt) == expected
 
 

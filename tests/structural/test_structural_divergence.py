@@ -9,7 +9,7 @@ from tumble import structural
 from tumble.ode import Status
 from tumble.structural import divergence
 from tumble.structural.schemes import resolve_scheme
-from tumble.structural.stepping import State
+from tumble.structural.stepping import BeamState
 
 ALUMINIUM = {"E": 70e9, "rho": 2700.0, "width": 0.02, "height": 0.003}
 STEEL = {"E": 210e9, "rho": 7850.0, "width": 0.01, "height": 0.01}
@@ -114,8 +114,14 @@ def test_long_stable_runs_never_fail_the_check(beam, scheme, steps_per_period):
     damping = structural.RayleighDamping.from_damping_ratio(0.02, *omega)
     run = structural.integrate(beam, scheme, dt, n_steps=5000, damping=damping, record_every=7)
     assert run.status == Status.SUCCESS, run.message
-    # measured at most 0.077 (from rest the bound is loose); 1e6 is where the check fires
-    assert np.max(mechanical_energy(beam, run)[1:] / bound(beam, run)[1:]) < 10
+    # From the first check on (step 64), what the check sees: measured at most 0.029 (from
+    # rest the bound is loose); 1e6 is where the check fires. Before it a scheme may
+    # overshoot: Wilson-θ's displacement after one step from a₀ grows as Ω² (module
+    # tumble.structural.wilson), 2e8 B at step 1 and 2.1e5 at step 7 at 0.3 steps a period
+    # (ωΔt up to 1e4), which ρ∞ = 0.78 a step takes to 7e-9 by step 64 (the others: 0.078
+    # at most from step 7 on).
+    checked = run.t >= divergence.CHECK_EVERY * dt * (1 - 1e-12)
+    assert np.max(mechanical_energy(beam, run)[checked] / bound(beam, run)[checked]) < 10
 
 
 @pytest.mark.parametrize(
@@ -170,7 +176,7 @@ def test_the_exact_motion_stays_within_the_bound(beam):
 
 
 def test_a_false_alarm_against_the_first_bound_computes_the_true_one(beam):
-    state = State.start(beam, np.zeros(beam.n_dofs), np.zeros(beam.n_dofs))
+    state = BeamState.start(beam, np.zeros(beam.n_dofs), np.zeros(beam.n_dofs))
     watch = divergence.EnergyWatch.start(beam, state.x, state.y, state.q, lambda f: 0 * f)
     assert watch.power == 0.0 and not watch.exact  # a "solve" that gives P_A = 0
     t = 1e-3
@@ -209,8 +215,7 @@ def checked_ratios(scheme, omega: np.ndarray, xi: float, steps: int = 640) -> np
     a0 = f - k * x0 - 2 * xi * np.sqrt(k) * y0
     static = f / k
     z = np.stack([x0 - static, y0, a0], axis=1)[:, : G.shape[1]]  # about the static solution
-    carries = G.shape[1] == 3 or (isinstance(scheme, structural.Newmark) and
-                                  2 * scheme.beta != scheme.gamma)  # fmt: skip
+    carries = resolve_scheme(scheme).carries_acceleration
     V0 = 0.5 * y0 * y0 + 0.5 * k * x0 * x0 + (0.5 * a0 * a0 if carries else 0.0)
     ratios = []
     for n in range(1, steps + 1):

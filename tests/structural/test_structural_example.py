@@ -6,6 +6,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tumble.structural import SCHEMES
+
 EXAMPLE = Path(__file__).resolve().parents[2] / "examples" / "beam.py"
 
 
@@ -30,16 +32,10 @@ def test_example_reports_the_semi_implicit_limit(numbers):
 
 
 def test_example_energy_behaviour(numbers):
-    assert numbers["status"] == {
-        "explicit": "FAILED",
-        "semi-implicit": "FAILED",
-        "implicit": "SUCCESS",
-        "midpoint": "SUCCESS",
-        "newmark": "SUCCESS",
-        "hht": "SUCCESS",
-        "generalized-alpha": "SUCCESS",
-        "bathe": "SUCCESS",
-    }
+    # at T₁/200 the two explicit schemes are far above 2/ω_max; every other scheme of the
+    # registry is stable at every Δt
+    failed = {"explicit": "FAILED", "semi-implicit": "FAILED"}
+    assert numbers["status"] == {name: failed.get(name, "SUCCESS") for name in SCHEMES}
     assert numbers["midpoint_energy_drift"] < 1e-9  # measured 1e-14
     assert numbers["implicit_energy_final"] < -0.1  # backward Euler has lost energy
     assert numbers["newmark_minus_midpoint"] < 1e-8 * 4e-3  # |x| ≤ 2 F L³/(3EI) = 3.8 mm

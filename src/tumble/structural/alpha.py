@@ -84,16 +84,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import ClassVar
 
 import numpy as np
 import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from tumble import _checks
-from tumble._progress import announce_compilation
-from tumble.structural.alpha_kernels import run_alpha_steps, run_bathe_steps
-from tumble.structural.factorization import BandedCholesky, factorize
-from tumble.structural.stepping import CompiledStepper, Reference, State, Watched
+from tumble.structural.alpha_kernels import ALPHA, BATHE
+from tumble.structural.scheme import Scheme
+from tumble.structural.stepping import BeamState, Solve
 from tumble.structural.system import LinearSystem
 
 
@@ -127,14 +127,15 @@ class AlphaCoefficients:
 
 
 @dataclass(frozen=True)
-class AlphaScheme:
+class AlphaScheme(Scheme):
     """A member of the generalized-α family, given by ``α_m, α_f, β, γ`` (module docstring).
 
     Use :class:`GeneralizedAlpha` (by ρ∞) or :class:`HHT` (by α); Newmark is
-    ``α_m = α_f = 0``.
+    ``α_m = α_f = 0``. Its state carries the acceleration (:class:`AlphaState`).
     """
 
     name: str = field(init=False, default="alpha")
+    kernel = ALPHA
 
     @property
     def parameters(self) -> tuple[float, float, float, float]:
@@ -147,6 +148,11 @@ class AlphaScheme:
         alpha_m, alpha_f, _, gamma = self.parameters
         return 2 if abs(gamma - (0.5 - alpha_m + alpha_f)) < 1e-14 else 1
 
+    @property
+    def carries_acceleration(self) -> bool:
+        """True: the state holds ``a`` and ``m = M a``."""
+        return True
+
     def matrices(self, system: LinearSystem, C: sp.spmatrix | None, dt: float) -> list:
         """The step matrix ``M + κ C + κ (β/γ) Δt S``, in a list (one factorisation)."""
         alpha_m, alpha_f, beta, gamma = self.parameters
@@ -154,20 +160,32 @@ class AlphaScheme:
         A = system.M + (kappa * beta / gamma * dt) * system.S
         return [A if C is None else A + kappa * C]
 
-    def start(self, system: LinearSystem, state: State, C, dt: float) -> AlphaState:
-        """The stepped state from ``(x, y, q, S y)``: ``a₀ = M⁻¹ r₀``, ``m₀ = r₀``."""
+    def coefficients(self, dt: float) -> tuple[float, ...]:
+        """:attr:`AlphaCoefficients.values` for ``dt`` [s]."""
+        return AlphaCoefficients.of(*self.parameters, dt).values
+
+    def start(
+        self, system: LinearSystem, state: BeamState, C: sp.spmatrix | None, dt: float,
+        acceleration: tuple[NDArray, NDArray] | None,
+    ) -> AlphaState:  # fmt: skip
+        """The stepped state from ``(x, y, q, S y)`` and ``(a₀, m₀ = M a₀)``, with
+        ``r₀ = q₀ − C y₀`` and ``p₀ = S(k_g y₀ + k_sa a₀)``."""
+        assert acceleration is not None, "it carries the acceleration: initial_state gives a₀"
+        a, m = acceleration
         r = state.q - (0.0 if C is None else C @ state.y)
-        a = factorize(system.M)(r)
-        _, _, k_g, k_sa, *_ = AlphaCoefficients.of(*self.parameters, dt).values
+        _, _, k_g, k_sa, *_ = self.coefficients(dt)
         p = system.internal_forces(k_g * state.y + k_sa * a)
-        return AlphaState(state.x, state.y, state.q, p, a, r.copy(), r)
+        return AlphaState(state.x, state.y, state.q, p, a, m.copy(), r)
 
-    def reference(self, system, C, dt: float, matrices: list) -> Watched:
-        return AlphaReference(system, C, AlphaCoefficients.of(*self.parameters, dt), matrices[0])
+    def step(
+        self, state: BeamState, system: LinearSystem, solves: list[Solve],
+        C: sp.spmatrix | None, coefficients: tuple[float, ...],
+    ) -> None:  # fmt: skip
+        alpha_step(state, coefficients, system, solves[0], C)  # type: ignore[arg-type]
 
-    def compiled(self, system, C, dt: float, factors: list, block: int) -> Watched:
-        coefficients = AlphaCoefficients.of(*self.parameters, dt)
-        return AlphaCompiled(system, C, coefficients, factors, block)
+    def critical_omega(self) -> float:
+        """``inf``: parameters that are not unconditionally stable are refused."""
+        return math.inf
 
 
 @dataclass(frozen=True)
@@ -234,19 +252,21 @@ class HHT(AlphaScheme):
 
 
 @dataclass
-class AlphaState(State):
-    """``x, y, q = f − S x`` and ``p = S(k_g y + k_sa a)`` (the next step's product), the
-    acceleration ``a``, ``m = M a`` and ``r = q − C y``, all carried."""
+class AlphaState(BeamState):
+    """``x, y, q = f − S x`` and ``g = p = S(k_g y + k_sa a)`` (the next step's product),
+    the acceleration ``a``, ``m = M a`` and ``r = q − C y``, all carried."""
 
     a: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     m: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
     r: NDArray[np.float64] = field(default_factory=lambda: np.zeros(0))
 
+    MODAL: ClassVar[tuple[str, ...]] = ("x", "y", "a")
+
 
 def alpha_step(state: AlphaState, values: tuple, system: LinearSystem, solve, C) -> None:
     """One generalized-α increment step (module docstring) in NumPy, in place."""
     dt, c_r, k_g, k_sa, k_dy, k_a, a_keep, a_gain, m_new, m_old, m_prev = values
-    dy = solve(dt * (c_r * state.r + (1.0 - c_r) * state.m - state.g))
+    dy = solve(dt * (c_r * state.r + (1.0 - c_r) * state.m - state.g))  # g holds p
     dx = dt * state.y + k_dy * dy + k_a * state.a
     state.x += dx
     state.y += dy
@@ -259,46 +279,8 @@ def alpha_step(state: AlphaState, values: tuple, system: LinearSystem, solve, C)
     state.r = r_new
 
 
-class AlphaReference(Reference):
-    """:func:`alpha_step` in NumPy with SuperLU, a stepper of the driver."""
-
-    def __init__(self, system: LinearSystem, C, coefficients: AlphaCoefficients, A):
-        self.system, self.C, self.values, self.solve = system, C, coefficients.values, factorize(A)
-        self.dt = self.values[0]
-
-    def advance(self, state: State) -> None:
-        alpha_step(state, self.values, self.system, self.solve, self.C)  # type: ignore[arg-type]
-
-    def acceleration_energy(self, state: State) -> float:
-        return _acceleration_energy(state, self.dt)
-
-
-def _acceleration_energy(state: State, dt: float) -> float:
-    """``½ Δt² a₀ᵀM a₀`` from the carried ``a`` and ``m = M a`` (the watch's start)."""
-    return 0.5 * dt * dt * max(float(state.a @ state.m), 0.0)  # type: ignore[attr-defined]
-
-
-class AlphaCompiled(CompiledStepper):
-    """:func:`~tumble.structural.alpha_kernels.run_alpha_steps` as a stepper of the driver."""
-
-    def __init__(self, system, C, coefficients: AlphaCoefficients, factors, block):
-        self.prepare(system, tuple(factors), C, block)
-        self.alpha_coefficients = coefficients.values
-        self.work = tuple(np.zeros(self.order.size) for _ in range(3))
-
-    def acceleration_energy(self, state: State) -> float:
-        return _acceleration_energy(state, self.alpha_coefficients[0])
-
-    def _run(self, state, k0, k1, steps, row, xs, ys):  # noqa: ANN001, ANN202
-        announce_compilation(run_alpha_steps, "the generalized-α time loop")
-        vectors = state.vectors()
-        return run_alpha_steps(k0, k1, steps, row, self.alpha_coefficients, vectors, self.frame,
-                               self.factors[0], self.damping, self.work, self.checks, xs,
-                               ys)  # fmt: skip
-
-
 @dataclass(frozen=True)
-class Bathe:
+class Bathe(Scheme):
     """The ρ∞-Bathe composite method (Noh & Bathe 2019; module docstring).
 
     Parameters
@@ -313,6 +295,7 @@ class Bathe:
     rho_inf: float = 0.0
     gamma: float | None = None
     name: str = field(init=False, default="bathe")
+    kernel = BATHE
 
     def __post_init__(self) -> None:
         _unit_interval("rho_inf", self.rho_inf)
@@ -321,8 +304,10 @@ class Bathe:
             if not 0 < gamma < 1:
                 raise _checks.fail("gamma", self.gamma, "in (0, 1): the splitting ratio")
 
-    order = 2
-    """Second order for every ρ∞ and γ (Noh & Bathe 2019, §2)."""
+    @property
+    def order(self) -> int:
+        """2, for every ρ∞ and γ (Noh & Bathe 2019, §2)."""
+        return 2
 
     @property
     def splitting(self) -> float:
@@ -339,7 +324,7 @@ class Bathe:
         return (gamma - 1) * q1 + 0.5, q1, -gamma * q1 + 0.5
 
     def coefficients(self, dt: float) -> tuple[float, ...]:
-        """``(Δt, τ = γΔt, d₀, d₁, q₂)`` (module docstring)."""
+        """``(Δt, τ = γΔt, d₀, d₁, q₂)`` (module docstring) for ``dt`` [s]."""
         gamma = self.splitting
         q0, _, q2 = self.weights
         return dt, gamma * dt, q0 - gamma / 2, 1 - q0 - gamma / 2, q2
@@ -352,17 +337,18 @@ class Bathe:
             out.append(A if C is None else A + c * C)
         return out
 
-    def start(self, system: LinearSystem, state: State, C, dt: float) -> State:
-        return state
+    def step(
+        self, state: BeamState, system: LinearSystem, solves: list[Solve],
+        C: sp.spmatrix | None, coefficients: tuple[float, ...],
+    ) -> None:  # fmt: skip
+        bathe_step(state, coefficients, system, solves, C)
 
-    def reference(self, system, C, dt: float, matrices: list) -> Watched:
-        return BatheReference(system, C, self.coefficients(dt), matrices)
-
-    def compiled(self, system, C, dt: float, factors: list, block: int) -> Watched:
-        return BatheCompiled(system, C, self.coefficients(dt), factors, block)
+    def critical_omega(self) -> float:
+        """``inf``: ρ∞ ∈ [0, 1] and γ ∈ (0, 1) are unconditionally stable."""
+        return math.inf
 
 
-def bathe_step(state: State, values: tuple, system: LinearSystem, solves, C) -> None:
+def bathe_step(state: BeamState, values: tuple, system: LinearSystem, solves, C) -> None:
     """One ρ∞-Bathe step (two sub-steps, module docstring) in NumPy, in place."""
     dt, tau, d0, d1, q2 = values
     r_old = state.q - (0.0 if C is None else C @ state.y)
@@ -380,31 +366,3 @@ def bathe_step(state: State, values: tuple, system: LinearSystem, solves, C) -> 
     state.y += dy
     state.q -= system.internal_forces(dx)
     state.g = system.internal_forces(state.y)
-
-
-class BatheReference(Reference):
-    """:func:`bathe_step` in NumPy with SuperLU, a stepper of the driver."""
-
-    def __init__(self, system: LinearSystem, C, values: tuple, matrices: list):
-        self.system, self.C, self.values, self.dt = system, C, values, values[0]
-        self.solves = [factorize(A) for A in matrices]
-        self.solve = self.solves[0]
-
-    def advance(self, state: State) -> None:
-        bathe_step(state, self.values, self.system, self.solves, self.C)
-
-
-class BatheCompiled(CompiledStepper):
-    """:func:`~tumble.structural.alpha_kernels.run_bathe_steps` as a stepper of the driver."""
-
-    def __init__(self, system, C, values: tuple, factors: list[BandedCholesky], block):
-        self.prepare(system, tuple(factors), C, block)
-        self.bathe_coefficients = values
-        self.work = tuple(np.zeros(self.order.size) for _ in range(6))
-
-    def _run(self, state, k0, k1, steps, row, xs, ys):  # noqa: ANN001, ANN202
-        announce_compilation(run_bathe_steps, "the ρ∞-Bathe time loop")
-        vectors = state.vectors()
-        return run_bathe_steps(k0, k1, steps, row, self.bathe_coefficients, vectors, self.frame,
-                               self.factors[0], self.factors[-1], self.damping, self.work,
-                               self.checks, xs, ys)  # fmt: skip

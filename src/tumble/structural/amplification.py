@@ -2,12 +2,12 @@
 
 Applied to the single-DOF oscillator ``ẍ + 2ξω ẋ + ω² x = 0`` with ``Ω = ωΔt``, every
 scheme of :data:`~tumble.structural.SCHEMES` is a linear map of its state,
-``zⁿ⁺¹ = G(Ω, ξ) zⁿ`` (``z = (x, Δt y)``, plus ``Δt² a`` for the generalized-α family).
-:func:`amplification` builds ``G`` column by column by running the scheme's *own* NumPy
-reference step (:func:`tumble.structural.stepping.reference_step`,
-:func:`tumble.structural.alpha.alpha_step`, :func:`tumble.structural.alpha.bathe_step`)
-on a one-DOF system with ``M = 1``, ``S = Ω²``, ``C = 2ξΩ``, ``Δt = 1``; so what is
-analysed is what runs. From its eigenvalues (Hughes 2000, §9.2; Chung & Hulbert 1993):
+``zⁿ⁺¹ = G(Ω, ξ) zⁿ`` (``z = (x, Δt y)``, plus ``Δt² a`` for a scheme whose state carries
+the acceleration, e.g. the generalized-α family). :func:`amplification` asks the scheme for
+``G`` (:meth:`~tumble.structural.scheme.Scheme.amplification_matrix`), which builds it
+column by column by running the scheme's *own* NumPy reference step on a one-DOF system
+with ``M = 1``, ``S = Ω²``, ``C = 2ξΩ``, ``Δt = 1``; so what is analysed is what runs.
+From its eigenvalues (Hughes 2000, §9.2; Chung & Hulbert 1993):
 
 - the spectral radius ``ρ = max |λ|``: stable where ``ρ ≤ 1``;
 - the principal pair ``λ = A ± iB = exp(Ω̄(−ξ̄ ± i))``: the algorithmic damping ratio
@@ -15,8 +15,9 @@ analysed is what runs. From its eigenvalues (Hughes 2000, §9.2; Chung & Hulbert
   with ``Ω̄ = atan2(B, A)``. Where the principal roots are real (a scheme that kills the
   mode within a step, e.g. Bathe or generalized-α with ρ∞ = 0 at large Ω) there is no
   period, and both are NaN;
-- the critical ``Ω`` above which ``ρ > 1`` (``2`` for ``semi-implicit``, ``0`` for
-  ``explicit``, ``1/√(γ/2 − β)`` for Newmark with ``2β < γ``, ``inf`` for the
+- the critical ``Ω`` above which ``ρ > 1``, the scheme's
+  :meth:`~tumble.structural.scheme.Scheme.critical_omega` (``2`` for ``semi-implicit``,
+  ``0`` for ``explicit``, ``1/√(γ/2 − β)`` for Newmark with ``2β < γ``, ``inf`` for the
   unconditionally stable).
 
 :func:`mode_table` applies it to every mode of a beam at a chosen ``Δt``: which modes
@@ -31,88 +32,15 @@ References
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
-import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from tumble import _checks
-from tumble.structural.alpha import AlphaScheme, AlphaState, Bathe, alpha_step, bathe_step
-from tumble.structural.schemes import Scheme, resolve_scheme
-from tumble.structural.stability import critical_omega
-from tumble.structural.stepping import State, reference_step
+from tumble.structural.scheme import Scheme
+from tumble.structural.schemes import resolve_scheme
 from tumble.structural.system import LinearSystem
-
-
-class _Oscillator:
-    """The one-DOF system ``ẍ + 2ξΩ ẋ + Ω² x = 0`` (Δt = 1), duck-typed as a LinearSystem
-    for the reference steps (they call ``internal_forces``, read ``f``, ``M``, ``S``)."""
-
-    def __init__(self, omega: float, xi: float):
-        self.stiffness = omega * omega
-        self.M = sp.csr_matrix(np.ones((1, 1)))
-        self.S = sp.csr_matrix(np.full((1, 1), self.stiffness))
-        self.f = np.zeros(1)
-        self.C = None if xi == 0 else sp.csr_matrix(np.full((1, 1), 2 * xi * omega))
-
-    def internal_forces(self, x: NDArray, out: NDArray | None = None) -> NDArray:
-        return self.stiffness * x
-
-
-def _step_matrix(scheme: Scheme, omega: float, xi: float) -> NDArray:
-    """``G`` for one ``Ω``: the scheme's reference step applied to each unit state."""
-    system: Any = _Oscillator(omega, xi)
-    if isinstance(scheme, AlphaScheme):
-        return _alpha_matrix(scheme, system)
-    C = system.C
-    columns = []
-    for x, y in np.eye(2):
-        state = State.start(system, np.array([x]), np.array([y]))
-        if isinstance(scheme, Bathe):
-            solves = [_divide_by(float(A[0, 0])) for A in scheme.matrices(system, C, 1.0)]
-            bathe_step(state, scheme.coefficients(1.0), system, solves, C)
-        else:
-            k = scheme.increments(1.0)
-            mass = _identity if k.mass_solve else None
-            solve = _divide_by(float(scheme.matrix(system, C, 1.0)[0, 0]))
-            reference_step(state, k, system, solve, mass, C)
-        columns.append([state.x[0], state.y[0]])
-    return np.array(columns).T
-
-
-def _identity(b: NDArray) -> NDArray:
-    return b
-
-
-def _divide_by(pivot: float) -> Callable[[NDArray], NDArray]:
-    """The solve with the 1 × 1 step matrix ``[pivot]``."""
-    return lambda b: b / pivot
-
-
-def _alpha_matrix(scheme: AlphaScheme, system: Any) -> NDArray:
-    """``G`` on ``(x, y, a)`` for the generalized-α family (``M = 1``, so ``m = a``)."""
-    C = system.C
-    pivot = float(scheme.matrices(system, C, 1.0)[0][0, 0])
-    values = _alpha_values(scheme)
-    k_g, k_sa = values[2], values[3]
-    columns = []
-    for x, y, a in np.eye(3):
-        q = np.array([-system.stiffness * x])
-        r = q - (0.0 if C is None else C @ [y])
-        p = system.stiffness * np.array([k_g * y + k_sa * a])
-        state = AlphaState(np.array([x]), np.array([y]), q, p, np.array([a]), np.array([a]), r)
-        alpha_step(state, values, system, _divide_by(pivot), C)
-        columns.append([state.x[0], state.y[0], state.a[0]])
-    return np.array(columns).T
-
-
-def _alpha_values(scheme: AlphaScheme) -> tuple:
-    from tumble.structural.alpha import AlphaCoefficients
-
-    return AlphaCoefficients.of(*scheme.parameters, 1.0).values
 
 
 @dataclass(frozen=True, eq=False)
@@ -178,7 +106,7 @@ def amplification(scheme: str | Scheme, omega: ArrayLike, xi: float = 0.0) -> Am
     xi = _checks.non_negative("xi", xi)
     if not xi < 1:
         raise _checks.fail("xi", xi, "in [0, 1): an underdamped oscillator")
-    G = np.array([_step_matrix(scheme, float(w), xi) for w in omega])
+    G = np.array([scheme.amplification_matrix(float(w), xi) for w in omega])
     eigenvalues = np.linalg.eigvals(G)
     radius = np.abs(eigenvalues).max(axis=1)
     principal = np.take_along_axis(eigenvalues, np.argmax(eigenvalues.imag, axis=1)[:, None], 1)
@@ -189,7 +117,7 @@ def amplification(scheme: str | Scheme, omega: ArrayLike, xi: float = 0.0) -> Am
         damping = -np.log(np.abs(principal) ** 2) / (2 * omega_bar)
         elongation = omega / omega_bar - 1
     return Amplification(scheme.name, omega, xi, G, radius, damping, elongation,
-                         float(critical_omega(scheme)))  # fmt: skip
+                         float(scheme.critical_omega()))  # fmt: skip
 
 
 @dataclass(frozen=True, eq=False)

@@ -252,6 +252,6 @@ def likely_cause(system: LinearSystem, scheme, dt: float) -> str:
 
 
 def describe(scheme) -> str:
-    """A scheme by its ``label`` when it has one (its parameters: ``Newmark β=1/6, γ=1/2``),
-    else by its name."""
-    return getattr(scheme, "label", None) or f"the {scheme.name} scheme"
+    """A scheme by its ``label`` (:class:`~tumble.structural.scheme.Scheme`: ``the
+    implicit scheme``, or with its parameters, ``Newmark β=1/6, γ=1/2``)."""
+    return scheme.label

@@ -6,11 +6,30 @@ scatter into the free-DOF vector, so that one call does no allocation and no Pyt
 per element. It takes each element's ``1/h``, ``EA/h`` and ``EI/h`` precomputed
 (:attr:`tumble.structural.system.FrameElements.kernel_arrays`): without the four divisions
 an element costs 3.4 ns instead of 4.7 ns (measured at 10⁴ elements).
-:func:`banded_solve` is the substitution with a banded Cholesky factor, and
-:func:`run_steps` the time loop of :mod:`tumble.structural.stepping`.
+:func:`banded_solve` is the substitution with a banded Cholesky factor.
+
+**The one time loop.** :func:`_loop` advances every structural scheme: it calls the
+scheme's compiled step (a ``@numba.njit(inline="always")`` function, the twin of its NumPy
+reference step), watches the energy (:func:`watch_step`, every
+:data:`~tumble.structural.divergence.CHECK_EVERY` steps and at the last), records every
+requested step and stops at a non-finite state or a failed check. :func:`time_loop`
+compiles it once per step function, with the step inlined, under a name of its own (so
+numba's on-disk cache keeps each). A step function reads
+
+``step(coefficients, state, frame, factors, damping, work) -> non_finite``
+
+with the scheme's constants, its state vectors (``x, y, q = f − S x`` first, then what it
+carries), the element arrays of :func:`assemble_internal_forces`, the banded factors of its
+step matrices, ``C`` as CSR and its scratch vectors; it updates the state in place and
+returns how many entries of ``x`` and ``y`` stopped being finite.
 """
 
 from __future__ import annotations
+
+import types
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
 
 import numba
 import numpy as np
@@ -223,58 +242,54 @@ def banded_solve(
         z = z[1:] + (acc,)
 
 
-@numba.njit(cache=True, nogil=True)
-def run_steps(
+def _loop(
     first: int,
     last: int,
     record_steps: NDArray[np.int64],
     row: int,
-    coefficients: tuple[float, float, float, float, float],
+    coefficients: tuple,
     state: tuple,
     frame: tuple,
-    factor: tuple,
-    mass_factor: tuple,
+    factors: tuple,
     damping: tuple,
     work: tuple,
+    lag: NDArray[np.float64],
     watch: tuple,
     xs: NDArray[np.float64],
     ys: NDArray[np.float64],
 ) -> tuple[int, int, float]:
-    """Steps ``first + 1 … last`` of :func:`tumble.structural.stepping.reference_step`.
-
-    The same operations in the same order, with the NumPy reference's sparse LU solve
-    replaced by :func:`banded_solve`, and no allocation: a pass for the right-hand side
-    (which also subtracts the previous step's ``S Δx`` from ``q``), the banded solve, a pass
-    for the update of ``x`` and ``y``, and one pass over the elements for ``S Δx`` and
-    ``S y`` together (:func:`assemble_internal_forces_pair`). Fusing the passes into the
-    two sweeps of the solve made a step 3–15 % slower (measured), so they stay apart.
+    """Steps ``first + 1 … last`` of one scheme: ``STEP`` (bound by :func:`time_loop`), the
+    energy watch and the records.
 
     Parameters
     ----------
     first, last : int
         Steps already taken, and the step to stop after.
-    record_steps : ndarray of int64, shape (n_records,)
-        The steps to record; ``row`` is the next row of ``xs``, ``ys`` to fill.
-    coefficients : tuple of 5 floats
-        ``(Δt, k_g, k_dy, k_sa, k_a)`` from :class:`~tumble.structural.stepping.Increments`;
-        ``k_sa != 0`` or ``k_a != 0`` switches on the mass solve.
-    state : tuple of 4 ndarrays, shape (n,)
-        ``(x, y, q, g)``: displacement, velocity, ``q = f − S x`` (carried) and ``S y``
-        (recomputed when ``k_g != 0``), updated in place.
+    record_steps : ndarray of int64, shape (n_records + 1,)
+        The steps to record, then one entry past the last (read, never recorded);
+        ``row`` is the next row of ``xs``, ``ys`` to fill.
+    coefficients : tuple of floats
+        The scheme's constants (:meth:`tumble.structural.scheme.Scheme.coefficients`),
+        ``Δt`` first.
+    state : tuple of ndarrays, shape (n,)
+        ``(x, y, q, …)``, the fields of the scheme's state, updated in place.
     frame : tuple
         ``(dof_map, 1/h, cos, sin, EA/h, EI/h)`` as in :func:`assemble_internal_forces`.
-    factor, mass_factor : tuple
-        ``(forward, backward, inverse_diagonal, window)`` of the step matrix and of ``M``
-        (any factor of the same bandwidth when there is no mass solve).
+    factors : tuple
+        ``(forward, backward, inverse_diagonal, window)`` of each step matrix, one bandwidth.
     damping : tuple of 3 ndarrays
         ``C`` as CSR ``(indptr, indices, data)``; ``indptr`` empty when undamped.
-    work : tuple of 4 ndarrays, shape (n,)
-        Scratch: right-hand side, then ``Δy``, then ``Δx``; ``S Δx``; ``a``; ``S a``.
+    work : tuple of ndarrays, shape (n,)
+        The step's scratch vectors.
+    lag : ndarray, shape (n,) or (0,)
+        A step that leaves its ``S Δx`` to be taken from ``q`` by the next step (one pass
+        fewer) keeps it here (one of ``work``); the loop zeroes it first, hands it to the
+        watch and takes it from ``q`` at the end. Empty for the others.
     watch : tuple
         The energy check (:func:`energy_exceeds`), made after every step that is a multiple
         of ``watch[0]`` and after step ``watch[1]`` (the run's last).
     xs, ys : ndarray, shape (n_records, n)
-        Records, filled from ``row``.
+        Records of ``x`` and ``y``, filled from ``row``.
 
     Returns
     -------
@@ -286,51 +301,15 @@ def run_steps(
     energy : float
         ``V`` at the failed check, or -1.0 (none failed: a non-finite state, or no stop).
     """
-    # The type: ignore[call-arg] below: numba's stubs count a *tuple into a Dispatcher wrongly.
-    dt, k_g, k_dy, k_sa, k_a = coefficients
-    use_mass = k_sa != 0.0 or k_a != 0.0
-    x, y, q, g = state
-    rhs, h, a, sa = work
-    indptr, indices, data = damping
-    n = x.size
-    h[:] = 0.0
+    x, y, q = state[0], state[1], state[2]
+    dt = coefficients[0]
     diverged, energy = -1, -1.0
+    lag[:] = 0.0
     until_check = watch[0] - first % watch[0]
     for k in range(first + 1, last + 1):
-        for i in range(n):  # r = q − C y, q = f − S x first taking the last step's S Δx
-            q[i] -= h[i]
-            r = q[i]
-            if indptr.size:
-                cy = 0.0
-                for j in range(indptr[i], indptr[i + 1]):
-                    cy += data[j] * y[indices[j]]
-                r -= cy
-            rhs[i] = r
-        if use_mass:  # a = M⁻¹ r
-            a[:] = rhs
-            banded_solve(mass_factor[0], mass_factor[1], mass_factor[2], a, mass_factor[3])
-            assemble_internal_forces(a, *frame, sa)  # type: ignore[call-arg]
-            for i in range(n):
-                rhs[i] -= k_sa * sa[i]
-        for i in range(n):
-            rhs[i] = dt * (rhs[i] - k_g * g[i])
-        banded_solve(factor[0], factor[1], factor[2], rhs, factor[3])  # rhs = Δy
-        non_finite = 0
-        for i in range(n):
-            dx = dt * y[i] + k_dy * rhs[i]
-            if use_mass:
-                dx += k_a * a[i]
-            x[i] += dx
-            y[i] += rhs[i]
-            rhs[i] = dx
-            non_finite += not (np.isfinite(x[i]) and np.isfinite(y[i]))
-        if k_g != 0.0:
-            # h = S Δx, g = S y
-            assemble_internal_forces_pair(rhs, y, *frame, h, g)  # type: ignore[call-arg]
-        else:
-            assemble_internal_forces(rhs, *frame, h)  # type: ignore[call-arg]
-        grown, energy, until_check = watch_step(k, until_check, non_finite, k * dt, x, y, q, h,
-                                                watch)  # fmt: skip
+        non_finite = STEP(coefficients, state, frame, factors, damping, work)  # type: ignore[name-defined]  # noqa: F821
+        grown, energy, until_check = watch_step(k, until_check, non_finite, k * dt, x, y, q,
+                                                lag, watch)  # fmt: skip
         if non_finite or k == record_steps[row]:
             xs[row] = x
             ys[row] = y
@@ -338,6 +317,49 @@ def run_steps(
         if non_finite or grown:
             diverged = k
             break
-    for i in range(n):
-        q[i] -= h[i]
+    for i in range(lag.size):
+        q[i] -= lag[i]
     return row, diverged, energy
+
+
+def time_loop(name: str, step: Callable[..., int]) -> Callable[..., tuple[int, int, float]]:
+    """:func:`_loop` compiled with ``step`` inlined, cached by numba under ``_loop_<name>``.
+
+    numba's on-disk cache is keyed by a function's qualified name and code, so each step's
+    loop gets a name of its own; a closure over the step would miss the cache. The loop
+    compiles on its first call (once per bandwidth of the factors, whose ``window`` tuple
+    is part of the type).
+    """
+    bound = types.FunctionType(_loop.__code__, {**globals(), "STEP": step}, f"_loop_{name}")
+    bound.__qualname__ = f"_loop_{name}"
+    bound.__doc__ = _loop.__doc__
+    return numba.njit(cache=True, nogil=True)(bound)
+
+
+@dataclass(frozen=True)
+class StepKernel:
+    """A scheme's compiled step, bound into the one time loop (module docstring).
+
+    Attributes
+    ----------
+    name : str
+        Names the loop in numba's cache (``_loop_<name>``) and in the notice of its first
+        compilation.
+    step : callable
+        ``step(coefficients, state, frame, factors, damping, work) -> non_finite``, a
+        ``@numba.njit(inline="always")`` function.
+    work : int
+        How many scratch vectors of the DOF count the step uses.
+    lag : int
+        The index in ``work`` of the ``S Δx`` the step leaves for the next one to take from
+        ``q``, or -1 (it takes it itself).
+    """
+
+    name: str
+    step: Callable[..., int]
+    work: int
+    lag: int = -1
+    loop: Any = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "loop", time_loop(self.name, self.step))

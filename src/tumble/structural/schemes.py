@@ -1,76 +1,51 @@
-"""Time-stepping schemes for ``M ẏ = f − S x − C y``, ``ẋ = y``, and one driver.
+"""The registry of structural schemes, :data:`SCHEMES`, and :func:`integrate`, which runs one.
 
-The seed's four schemes differ only in which ``x`` and ``y`` the right-hand side uses, so
-each is two numbers (:class:`ThetaScheme`):
+Every scheme is a :class:`~tumble.structural.scheme.Scheme` (the contract: its matrices,
+start, NumPy and compiled step, amplification matrix, critical step, order and label), and
+each family lives in one module:
 
-.. math::
+- :mod:`~tumble.structural.increments`: the seed's four (:class:`ThetaScheme`:
+  ``explicit``, ``semi-implicit``, ``implicit``, ``midpoint``) and ``newmark``
+  (:class:`Newmark`, average acceleration by default);
+- :mod:`~tumble.structural.alpha`: ``hht``, ``generalized-alpha`` (by ρ∞) and ``bathe``
+  (the ρ∞-Bathe composite), with controllable numerical damping;
+- :mod:`~tumble.structural.wilson`: ``wilson`` (Wilson-θ, θ = 1.4 by default).
 
-    M (y^{n+1} - y^n) = Δt \\,(f - S x^θ - C y^θ), \\qquad x^{n+1} = x^n + Δt\\, y^θ,
+:data:`SCHEMES` is the one list of them: the tests, ``tumble stability --analyse``, the
+report card and the docs iterate over it, and nothing else names a scheme class. Adding a
+family is its module and one line here.
 
-    x^θ = (1 - θ_x) x^n + θ_x x^{n+1}, \\qquad y^θ = (1 - θ_y) y^n + θ_y y^{n+1}.
-
-=============== ====== ====== ========================================================
-name            θ_x    θ_y    seed name; stability
-=============== ====== ====== ========================================================
-explicit        0      0      "almost explicit"; unstable for every Δt
-semi-implicit   0      1      "semi-implicit" (symplectic Euler); Δt < 2/ω_max
-implicit        1      1      "fully implicit" (backward Euler); unconditional, dissipates
-midpoint        ½      ½      "w pół kroku" (quarter steps); unconditional, keeps energy
-=============== ====== ====== ========================================================
-
-Eliminating ``x^{n+1}`` gives one linear system per step with a constant matrix,
-factorised once:
-
-.. math::
-
-    (M + θ_y Δt C + θ_x θ_y Δt^2 S)\\, Δy = Δt\\,(r^n - θ_x Δt\\, S y^n), \\qquad
-    Δx = Δt\\,(y^n + θ_y Δy),
-
-with ``r^n = f − S x^n − C y^n``. :class:`Newmark` (average acceleration by default) is the
-same kind of step. Every scheme is written *in increments* (:mod:`tumble.structural.stepping`):
-the out-of-balance force ``f − S x`` is carried along and updated by ``S Δx`` computed
-element by element, never recomputed from the global matrix. On fine meshes
-(``κ(S) ∝ N⁴``) that keeps the midpoint tip deflection within 1.1e-4 (of ``F L³/3EI``) of
-a converged 100-element run over 2000 steps at N = 10000, where the seed's plain form
-(``b = M y + Δt (f − S x)`` each step) is off by 195 % and increments with a global
-``S Δx`` by 193 % (measured).
-
-:func:`integrate` factorises the constant matrix once — banded Cholesky when its band is
-narrow (every beam, and every frame numbered along its members or renumbered by reverse
-Cuthill–McKee), sparse LU otherwise (:mod:`tumble.structural.factorization`) — and with the
-banded factor runs the whole time loop compiled (:func:`tumble.structural.kernels.run_steps`).
-
-Three schemes with controllable numerical damping join them in :data:`SCHEMES`, written in
-the same increments with their own compiled loops (:mod:`tumble.structural.alpha`):
-``hht`` (:class:`~tumble.structural.alpha.HHT`), ``generalized-alpha``
-(:class:`~tumble.structural.alpha.GeneralizedAlpha`, by ρ∞) and ``bathe``
-(:class:`~tumble.structural.alpha.Bathe`, the ρ∞-Bathe composite). Every scheme declares its
-``order`` (the tests measure it against :func:`~tumble.structural.exact_response`).
+:func:`integrate` factorises the scheme's matrices once — banded Cholesky when their band
+is narrow (every beam, and every frame numbered along its members or renumbered by reverse
+Cuthill–McKee), sparse LU otherwise (:mod:`tumble.structural.factorization`) — and with
+the banded factors runs the whole time loop compiled
+(:class:`~tumble.structural.stepping.CompiledBeamStepper`: the scheme's compiled step inside
+the one loop of :func:`tumble.structural.kernels.time_loop`), else the NumPy reference
+(:class:`~tumble.structural.stepping.ReferenceBeamStepper`). Both are steppers of the
+driver, :func:`tumble.ode.driver.march`. Every scheme is written *in increments*: the
+out-of-balance force ``f − S x`` is carried and updated by ``S Δx`` computed element by
+element, never recomputed from the global matrix (:mod:`~tumble.structural.increments`:
+why, with the numbers).
 
 References
 ----------
 .. [1] Ł. Łaniewski-Wołłk, *Metody Numeryczne, Instrukcja 5: Równania ruchu* (seed 003).
-.. [2] N. M. Newmark, "A method of computation for structural dynamics", *J. Eng. Mech.
-   Div. ASCE* 85 (EM3), 67–94, 1959.
-.. [3] T. J. R. Hughes, *The Finite Element Method*, Dover, 2000, §9.1–9.3.
+.. [2] T. J. R. Hughes, *The Finite Element Method*, Dover, 2000, §9.1–9.3.
 """
 
 from __future__ import annotations
 
 import contextlib
 import math
-from dataclasses import dataclass, field
-from fractions import Fraction
+from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 from numpy.typing import ArrayLike, NDArray
 
 from tumble import _checks
 from tumble._progress import progress_bar
 from tumble.ode.driver import Status, march
-from tumble.structural import stepping
-from tumble.structural.alpha import HHT, AlphaScheme, Bathe, GeneralizedAlpha
+from tumble.structural.alpha import HHT, Bathe, GeneralizedAlpha
 from tumble.structural.divergence import likely_cause
 from tumble.structural.factorization import (
     MAX_BANDWIDTH,
@@ -78,103 +53,23 @@ from tumble.structural.factorization import (
     band_structure,
     banded_cholesky,
 )
-from tumble.structural.stepping import Increments, State
+from tumble.structural.increments import Newmark, ThetaScheme
+from tumble.structural.scheme import Scheme
+from tumble.structural.stepping import (
+    BeamState,
+    CompiledBeamStepper,
+    ReferenceBeamStepper,
+    Watched,
+    initial_state,
+)
 from tumble.structural.system import LinearSystem, RayleighDamping
+from tumble.structural.wilson import WilsonTheta
 
 PROGRESS_UPDATES = 200
 """A progress bar is advanced about this many times per run."""
 
 BLOCK_WORK = 2**24
 """Without a progress bar the compiled loop takes about this many DOF-steps per call."""
-
-
-@dataclass(frozen=True)
-class ThetaScheme:
-    """A seed scheme: which of old/new ``x`` (θ_x) and ``y`` (θ_y) the step uses.
-
-    See the module docstring for the equations. Instances: :data:`EXPLICIT`,
-    :data:`SEMI_IMPLICIT`, :data:`IMPLICIT`, :data:`MIDPOINT`.
-    """
-
-    name: str
-    theta_x: float
-    theta_y: float
-    seed_name: str
-
-    @property
-    def order(self) -> int:
-        """Order of accuracy: 2 for θ_x = θ_y = ½ (midpoint), else 1."""
-        return 2 if self.theta_x == self.theta_y == 0.5 else 1
-
-    def matrix(self, system: LinearSystem, C: sp.spmatrix | None, dt: float) -> sp.spmatrix:
-        """The constant matrix ``M + θ_y Δt C + θ_x θ_y Δt² S``."""
-        A = system.M + (self.theta_x * self.theta_y * dt * dt) * system.S
-        return A if C is None else A + (self.theta_y * dt) * C
-
-    def increments(self, dt: float) -> Increments:
-        """``k_g = θ_x Δt``, ``k_dy = θ_y Δt``: ``Δx = Δt (yⁿ + θ_y Δy)``."""
-        return Increments(dt, self.theta_x * dt, self.theta_y * dt)
-
-
-@dataclass(frozen=True)
-class Newmark:
-    """Newmark-β: ``x⁺ = x + Δt y + Δt²((½ − β) a + β a⁺)``, ``y⁺ = y + Δt((1 − γ) a + γ a⁺)``.
-
-    With ``M a = f − S x − C y`` at every step. Written in velocity increments like the
-    θ-schemes, using ``M aⁿ = rⁿ``:
-
-    .. math::
-
-        (M + γ Δt C + β Δt^2 S)\\, Δy = Δt\\,(r^n - γ Δt\\, S y^n - (γ/2 - β) Δt^2 S a^n),
-
-        Δx = Δt\\, y^n + (β/γ) Δt\\, Δy + (½ - β/γ) Δt^2 a^n,
-
-    where ``aⁿ = M⁻¹ rⁿ`` is needed only when ``2β ≠ γ``. β = ¼, γ = ½ (average
-    acceleration, the default) is the midpoint scheme; it is unconditionally stable for
-    ``2β ≥ γ ≥ ½``.
-
-    Parameters
-    ----------
-    beta : float
-        β ≥ 0.
-    gamma : float
-        γ > 0 (γ < ½ is unstable, γ > ½ damps high frequencies).
-    """
-
-    beta: float = 0.25
-    gamma: float = 0.5
-    name: str = field(default="newmark", init=False)
-
-    def __post_init__(self) -> None:
-        _checks.non_negative("beta", self.beta)
-        _checks.positive("gamma", self.gamma)
-
-    @property
-    def order(self) -> int:
-        """Order of accuracy: 2 for γ = ½, else 1 (Hughes 2000, §9.1)."""
-        return 2 if self.gamma == 0.5 else 1
-
-    @property
-    def label(self) -> str:
-        """The scheme with its parameters, as messages name it: ``Newmark β=1/6, γ=1/2``."""
-        return f"Newmark β={_fraction(self.beta)}, γ={_fraction(self.gamma)}"
-
-    def matrix(self, system: LinearSystem, C: sp.spmatrix | None, dt: float) -> sp.spmatrix:
-        """The constant matrix ``M + γ Δt C + β Δt² S``."""
-        A = system.M + (self.beta * dt * dt) * system.S
-        return A if C is None else A + (self.gamma * dt) * C
-
-    def increments(self, dt: float) -> Increments:
-        """The constants of the equations above; the ``aⁿ`` terms vanish when ``2β = γ``."""
-        beta, gamma = self.beta, self.gamma
-        return Increments(
-            dt,
-            k_g=gamma * dt,
-            k_dy=beta / gamma * dt,
-            k_sa=(gamma / 2 - beta) * dt * dt,
-            k_a=(0.5 - beta / gamma) * dt * dt,
-        )
-
 
 EXPLICIT = ThetaScheme("explicit", 0.0, 0.0, "almost explicit")
 SEMI_IMPLICIT = ThetaScheme("semi-implicit", 0.0, 1.0, "semi-implicit")
@@ -185,18 +80,16 @@ HHT_ALPHA = HHT()
 GENERALIZED_ALPHA = GeneralizedAlpha()
 BATHE = Bathe()
 
-Scheme = ThetaScheme | Newmark | AlphaScheme | Bathe
-
 SCHEMES: dict[str, Scheme] = {
     s.name: s
     for s in (EXPLICIT, SEMI_IMPLICIT, IMPLICIT, MIDPOINT, NEWMARK, HHT_ALPHA, GENERALIZED_ALPHA,
-              BATHE)
+              BATHE, WilsonTheta())
 }  # fmt: skip
 """The schemes by name, with their default parameters: ``newmark`` β = ¼, γ = ½; ``hht``
-α = −0.05; ``generalized-alpha`` ρ∞ = 0.8; ``bathe`` ρ∞ = 0 (the original Bathe method).
-Pass :class:`Newmark`, :class:`~tumble.structural.alpha.HHT`,
-:class:`~tumble.structural.alpha.GeneralizedAlpha` or :class:`~tumble.structural.alpha.Bathe`
-to change them."""
+α = −0.05; ``generalized-alpha`` ρ∞ = 0.8; ``bathe`` ρ∞ = 0 (the original Bathe method);
+``wilson`` θ = 1.4. Pass :class:`Newmark`, :class:`~tumble.structural.alpha.HHT`,
+:class:`~tumble.structural.alpha.GeneralizedAlpha`, :class:`~tumble.structural.alpha.Bathe`
+or :class:`~tumble.structural.wilson.WilsonTheta` to change them."""
 
 SEED_SCHEMES = ("explicit", "semi-implicit", "implicit", "midpoint")
 """The four schemes of seed 003, in its order."""
@@ -259,7 +152,7 @@ class Response:
 
 def resolve_scheme(scheme: str | Scheme) -> Scheme:
     """A scheme object from its name (one of :data:`SCHEMES`) or the object itself."""
-    if isinstance(scheme, ThetaScheme | Newmark | AlphaScheme | Bathe):
+    if isinstance(scheme, Scheme):
         return scheme
     return SCHEMES[_checks.choice("scheme", scheme, SCHEMES)]
 
@@ -280,12 +173,12 @@ def integrate(
 ) -> Response:
     """Step ``M ẍ + C ẋ + S x = f`` from ``(x0, y0)`` with a fixed time step.
 
-    The scheme's constant matrix is factorised once, by its structure
+    The scheme's constant matrices are factorised once, by their structure
     (:func:`~tumble.structural.factorization.band_structure`): banded Cholesky when the
     band is narrow, and then the whole loop runs compiled
-    (:func:`~tumble.structural.kernels.run_steps`), a step costing one banded solve and
-    one pass over the elements; otherwise SuperLU and the NumPy reference loop
-    (:mod:`tumble.structural.stepping`).
+    (:func:`~tumble.structural.kernels.time_loop`), a step costing one banded solve and
+    one pass over the elements (two of each for Bathe); otherwise SuperLU and the NumPy
+    reference (:mod:`tumble.structural.stepping`).
 
     Parameters
     ----------
@@ -293,9 +186,10 @@ def integrate(
         From :func:`~tumble.structural.cantilever` or :func:`~tumble.structural.build_frame`.
     scheme : str or scheme object
         A name from :data:`SCHEMES` (``"explicit"``, ``"semi-implicit"``, ``"implicit"``,
-        ``"midpoint"``, ``"newmark"``, ``"hht"``, ``"generalized-alpha"``, ``"bathe"``), or
-        a scheme with its parameters, e.g. ``Newmark(beta=0.3025, gamma=0.6)``,
-        ``GeneralizedAlpha(rho_inf=0.5)`` (:mod:`tumble.structural.alpha`).
+        ``"midpoint"``, ``"newmark"``, ``"hht"``, ``"generalized-alpha"``, ``"bathe"``,
+        ``"wilson"``), or a scheme with its parameters, e.g.
+        ``Newmark(beta=0.3025, gamma=0.6)``, ``GeneralizedAlpha(rho_inf=0.5)``
+        (:mod:`tumble.structural.alpha`), ``WilsonTheta(theta=1.5)``.
     dt : float
         Time step [s], > 0.
     n_steps, t_end : int or float
@@ -346,9 +240,8 @@ def integrate(
         max(1, BLOCK_WORK // system.n_dofs),
     )  # Ctrl-C is seen between blocks; fmt: skip
     stepper, solver = _choose_stepper(system, scheme, dt, C, compiled, block)
-    if isinstance(scheme, AlphaScheme | Bathe):
-        state = scheme.start(system, state, C, dt)
-    start = stepper.start(state)
+    state, acceleration_energy = initial_state(scheme, system, state, C, dt)
+    start = stepper.start(state, acceleration_energy)
     stepper.watch.final = n_steps  # checked at the last step too
     with progress_bar(progress, n_steps, scheme.name) as update, _quiet_overflow():
 
@@ -379,24 +272,14 @@ def integrate(
 
 def _choose_stepper(
     system: LinearSystem, scheme: Scheme, dt: float, C, compiled: bool | None, block: int
-) -> tuple[stepping.Watched, str]:
+) -> tuple[Watched, str]:
     """The compiled stepper with banded Cholesky factors of the step matrices, or the
     reference stepper with SuperLU; and the solver's name."""
-    if isinstance(scheme, AlphaScheme | Bathe):
-        matrices = scheme.matrices(system, C, dt)
-    else:
-        matrices = [scheme.matrix(system, C, dt)]
+    matrices = scheme.matrices(system, C, dt)
     factors = _banded_factors(matrices, compiled)
     if factors is None:
-        if isinstance(scheme, AlphaScheme | Bathe):
-            return scheme.reference(system, C, dt, matrices), "sparse-lu"
-        return stepping.ReferenceStepper(
-            system, scheme.increments(dt), matrices[0], C
-        ), "sparse-lu"
-    if isinstance(scheme, AlphaScheme | Bathe):
-        return scheme.compiled(system, C, dt, factors, block), "banded-cholesky"
-    stepper = stepping.CompiledStepper(system, scheme.increments(dt), factors[0], C, block)
-    return stepper, "banded-cholesky"
+        return ReferenceBeamStepper(system, scheme, C, dt, matrices), "sparse-lu"
+    return CompiledBeamStepper(system, scheme, C, dt, factors, block), "banded-cholesky"
 
 
 def _banded_factors(matrices: list, compiled: bool | None) -> list[BandedCholesky] | None:
@@ -434,7 +317,7 @@ def _step_count(n_steps: int | None, t_end: float | None, dt: float) -> int:
     return max(1, math.ceil(t_end / dt * (1 - 1e-12)))
 
 
-def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | None) -> State:
+def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | None) -> BeamState:
     start = []
     shape = (system.n_dofs,)
     for name, value, unit in (("x0", x0, "m, rad"), ("y0", y0, "m/s, rad/s")):
@@ -442,17 +325,9 @@ def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | N
             start.append(np.zeros(shape))
         else:
             start.append(_checks.array(name, value, shape=shape, unit=unit))
-    return State.start(system, *start)
+    return BeamState.start(system, *start)
 
 
 def _quiet_overflow() -> contextlib.AbstractContextManager:
     """Diverging schemes overflow by design; the driver reports it as a status."""
     return np.errstate(over="ignore", invalid="ignore")
-
-
-def _fraction(value: float) -> str:
-    """``1/6`` for a simple fraction, else 4 digits."""
-    fraction = Fraction(value).limit_denominator(64)
-    if abs(float(fraction) - value) <= 1e-12 * abs(value):
-        return str(fraction)
-    return f"{value:.4g}"

@@ -1,26 +1,18 @@
 """For which time steps each scheme is stable: the critical step and a dt sweep.
 
-Applied to one mode ``ẍ = −ω² x`` with ``z = ω Δt``, a :class:`ThetaScheme` step is a
-2 × 2 map ``G`` with
-
-.. math::
-
-    \\det G = \\frac{1 + z^2 (1-θ_x)(1-θ_y)}{1 + z^2 θ_x θ_y}, \\qquad
-    \\operatorname{tr} G = \\frac{2 - z^2 (θ_x + θ_y - 2 θ_x θ_y)}{1 + z^2 θ_x θ_y}.
-
-It is stable when ``|det G| ≤ 1`` and ``|tr G| ≤ 1 + det G``: never if ``θ_x + θ_y < 1``
-(the explicit scheme: energy grows at every step, by ``½ Δyᵀ M Δy + ½ Δxᵀ S Δx``);
-otherwise for ``z < 2/sqrt(q)`` with ``q = 2θ_x + 2θ_y − 4θ_xθ_y − 1``, which is
-``Δt < 2/ω_max`` for the semi-implicit scheme and every Δt (``q ≤ 0``) for the implicit
-and midpoint schemes. Newmark is unconditionally stable for ``2β ≥ γ ≥ ½``, unstable for
-``γ < ½``, and otherwise needs ``ω_max Δt < 1/sqrt(γ/2 − β)`` (Hughes 2000, §9.1.2).
-These are the undamped limits; Rayleigh damping only enlarges them here.
+Each scheme knows the largest ``Ω = ωΔt`` at which one mode stays bounded
+(:meth:`~tumble.structural.scheme.Scheme.critical_omega`: a closed form for the seed's
+schemes and Newmark, :mod:`tumble.structural.increments`; ``inf`` for the damped families,
+which refuse parameters that are not unconditionally stable; by default, where the
+spectral radius of its amplification matrix first exceeds 1). :func:`critical_dt`
+turns it into a time step with the system's highest mode, ``Δt_crit = Ω_crit/ω_max``, and
+says whether that mode is axial or bending. These are the undamped limits; Rayleigh damping
+only enlarges them here. :func:`stability_sweep` measures it: runs at a range of Δt and the
+energy's growth in each.
 
 References
 ----------
 .. [1] T. J. R. Hughes, *The Finite Element Method*, Dover, 2000, §9.1.2.
-.. [2] E. Hairer, C. Lubich, G. Wanner, *Geometric Numerical Integration*, 2nd ed.,
-   Springer, 2006, §I.1 (symplectic Euler) and §IX (modified energy).
 """
 
 from __future__ import annotations
@@ -34,8 +26,8 @@ import scipy.sparse.linalg as spla
 from numpy.typing import ArrayLike, NDArray
 
 from tumble import _checks
-from tumble.structural.alpha import AlphaScheme, Bathe
-from tumble.structural.schemes import Newmark, Scheme, integrate, resolve_scheme
+from tumble.structural.scheme import Scheme
+from tumble.structural.schemes import integrate, resolve_scheme
 from tumble.structural.system import DENSE_EIGEN_LIMIT, LinearSystem
 
 STABLE_GROWTH = 1.0
@@ -72,19 +64,23 @@ class CriticalStep:
 
 
 def critical_dt(system: LinearSystem, scheme: str | Scheme) -> CriticalStep:
-    """The critical time step: ``2/ω_max`` for ``semi-implicit``, 0 for ``explicit``.
+    """The critical time step ``Ω_crit/ω_max``: ``2/ω_max`` for ``semi-implicit``, 0 for
+    ``explicit``.
 
+    ``Ω_crit`` is the scheme's :meth:`~tumble.structural.scheme.Scheme.critical_omega`.
     ``explicit`` is unstable for every ``dt > 0`` (each mode is amplified by
-    ``sqrt(1 + ω²Δt²)`` per step), so its critical step is 0. ``implicit``, ``midpoint``
-    and ``newmark`` with ``2β ≥ γ ≥ ½`` are unconditionally stable: ``inf``. Where a limit
-    exists it is set by the highest mode ``ω_max`` of ``S φ = ω² M φ``, reported with
-    whether that mode is axial or bending: on a coarse frame with axial DOFs it is often
-    axial, and a transverse load never excites it, so a run can survive above the limit.
+    ``sqrt(1 + ω²Δt²)`` per step), so its critical step is 0. ``implicit``, ``midpoint``,
+    ``newmark`` with ``2β ≥ γ ≥ ½`` and the damped families are unconditionally stable:
+    ``inf``. Where a limit exists it is set
+    by the highest mode ``ω_max`` of ``S φ = ω² M φ``, reported with whether that mode is
+    axial or bending: on a coarse frame with axial DOFs it is often axial, and a transverse
+    load never excites it, so a run can survive above the limit.
 
     Parameters
     ----------
     system : LinearSystem
-    scheme : str or ThetaScheme or Newmark
+    scheme : str or Scheme
+        A name from :data:`~tumble.structural.SCHEMES` or a scheme with its parameters.
 
     Returns
     -------
@@ -100,27 +96,11 @@ def critical_dt(system: LinearSystem, scheme: str | Scheme) -> CriticalStep:
     ('5.593e-06 s', 'bending', inf)
     """
     scheme = resolve_scheme(scheme)
-    z_max = critical_omega(scheme)
+    z_max = scheme.critical_omega()
     if z_max == 0.0 or math.isinf(z_max):
         return CriticalStep(scheme.name, z_max)
     omega, shape = highest_mode(system)
     return CriticalStep(scheme.name, z_max / omega, omega, mode_kind(system, shape))
-
-
-def critical_omega(scheme: Scheme) -> float:
-    """Largest stable ``ω Δt`` of a scheme (0: never stable; inf: always)."""
-    if isinstance(scheme, AlphaScheme | Bathe):  # refused unless unconditionally stable
-        return math.inf
-    if isinstance(scheme, Newmark):
-        beta, gamma = scheme.beta, scheme.gamma
-        if gamma < 0.5:
-            return 0.0
-        return math.inf if 2 * beta >= gamma else 1.0 / math.sqrt(gamma / 2 - beta)
-    theta_x, theta_y = scheme.theta_x, scheme.theta_y
-    if theta_x + theta_y < 1:
-        return 0.0
-    q = 2 * theta_x + 2 * theta_y - 4 * theta_x * theta_y - 1
-    return math.inf if q <= 0 else 2.0 / math.sqrt(q)
 
 
 def highest_mode(system: LinearSystem) -> tuple[float, NDArray]:

@@ -1,35 +1,34 @@
-"""How one step is computed, twice: a readable NumPy reference and the compiled loop.
+"""How a scheme is stepped, twice: a NumPy reference and the one compiled loop.
 
-Every scheme of :mod:`tumble.structural.schemes` is the same increment step with four
-constants (:class:`Increments`). With ``r = q − C y``, ``q = f − S x`` and, for Newmark with
-``2β ≠ γ``, ``a = M⁻¹ r``:
+Every scheme of :data:`tumble.structural.SCHEMES` is a
+:class:`~tumble.structural.scheme.Scheme`: constant step matrices, factorised once, and a
+step that updates a :class:`BeamState` in place. The state carries the out-of-balance force
+``q = f − S x``, updated by ``S Δx`` summed element by element
+(:meth:`~tumble.structural.system.LinearSystem.internal_forces`) and never formed as
+``f − S x`` from the global matrix: on fine meshes (``κ(S) ∝ N⁴``) that is a difference of
+huge numbers, and carrying the small ``q`` rounds it relative to its own size.
 
-.. math::
+Two steppers of the one driver, :func:`tumble.ode.driver.march` (which owns the run), take
+any scheme:
 
-    A\\, Δy = Δt\\,(r - k_{sa}\\, S a - k_g\\, S y), \\qquad
-    Δx = Δt\\, y + k_{dy}\\, Δy + k_a\\, a,
+- :class:`ReferenceBeamStepper` runs the scheme's NumPy step
+  (:meth:`~tumble.structural.scheme.Scheme.step`) with SuperLU
+  (:func:`~tumble.structural.factorization.factorize`), one Python call a step;
+- :class:`CompiledBeamStepper` runs its compiled twin
+  (:attr:`~tumble.structural.scheme.Scheme.kernel`) inside the one time loop
+  (:func:`tumble.structural.kernels.time_loop`) with the banded Cholesky of
+  :class:`~tumble.structural.factorization.BandedCholesky`, many steps per call.
 
-then ``x += Δx``, ``y += Δy`` and ``q −= S Δx``. Every product with ``S`` is summed
-element by element (:meth:`~tumble.structural.system.LinearSystem.internal_forces`), and the
-out-of-balance force ``q`` is carried along, never formed as ``f − S x`` from the global
-matrix: on fine meshes (``κ(S) ∝ N⁴``) that is a difference of huge numbers, and carrying
-the small ``q`` rounds it relative to its own size. ``S y`` is summed afresh each step
-(carrying it too made the midpoint energy drift 10× faster, measured). A step costs one
-solve with the constant ``A`` and one pass over the elements for ``S Δx`` and ``S y``
-(plus a mass solve and ``S a`` for Newmark with ``2β ≠ γ``).
-
-:class:`ReferenceStepper` runs it in Python with SuperLU (:func:`~tumble.structural.
-factorization.factorize`); :class:`CompiledStepper` runs the same operations in the same
-order in :func:`tumble.structural.kernels.run_steps`, with the banded Cholesky of
-:class:`~tumble.structural.factorization.BandedCholesky`, many steps per call. Both are
-steppers of the one driver, :func:`tumble.ode.driver.march`, which owns the time loop.
-Tests check that the two agree to round-off.
+Both watch the energy (:mod:`tumble.structural.divergence`) every
+:data:`~tumble.structural.divergence.CHECK_EVERY` steps; tests check that the two agree to
+round-off for every scheme.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING, ClassVar
 
 import numpy as np
 import scipy.sparse as sp
@@ -39,120 +38,91 @@ from tumble._progress import announce_compilation
 from tumble.ode.driver import Block, Grid, Stepper, non_finite_message
 from tumble.structural.divergence import EnergyWatch, mechanical_energy
 from tumble.structural.factorization import BandedCholesky, factorize
-from tumble.structural.kernels import all_finite, run_steps
+from tumble.structural.kernels import all_finite
 from tumble.structural.system import LinearSystem
 
+if TYPE_CHECKING:
+    from tumble.structural.scheme import Scheme
 
-@dataclass(frozen=True)
-class Increments:
-    """The constants of one increment step (module docstring), for a scheme and a Δt.
-
-    Attributes
-    ----------
-    dt : float
-        Time step Δt [s].
-    k_g : float
-        [s]: ``θ_x Δt`` for a θ-scheme, ``γ Δt`` for Newmark.
-    k_dy : float
-        [s]: ``θ_y Δt``, or ``(β/γ) Δt``.
-    k_sa : float
-        [s²]: ``(γ/2 − β) Δt²`` for Newmark, else 0.
-    k_a : float
-        [s²]: ``(½ − β/γ) Δt²`` for Newmark, else 0.
-    """
-
-    dt: float
-    k_g: float
-    k_dy: float
-    k_sa: float = 0.0
-    k_a: float = 0.0
-
-    @property
-    def mass_solve(self) -> bool:
-        """Whether a step needs ``a = M⁻¹ r`` (Newmark with ``2β ≠ γ``)."""
-        return self.k_sa != 0.0 or self.k_a != 0.0
+Solve = Callable[[NDArray], NDArray]
 
 
 @dataclass
-class State:
-    """The stepped state: ``x``, ``y``, ``q = f − S x`` (carried) and ``g = S y`` (summed)."""
+class BeamState:
+    """The stepped state: ``x``, ``y``, ``q = f − S x`` (carried) and ``g``, a product with
+    ``S`` that the next step needs (``S y`` for the increment schemes; each scheme says).
+
+    A scheme that carries more (the acceleration, …) subclasses it with more fields;
+    :attr:`MODAL` names the fields that make up its state on one mode (the amplification
+    matrix acts on them).
+    """
 
     x: NDArray[np.float64]
     y: NDArray[np.float64]
     q: NDArray[np.float64]
     g: NDArray[np.float64]
 
+    MODAL: ClassVar[tuple[str, ...]] = ("x", "y")
+
     @classmethod
-    def start(cls, system: LinearSystem, x: NDArray, y: NDArray) -> State:
+    def start(cls, system: LinearSystem, x: NDArray, y: NDArray) -> BeamState:
         """The state at ``(x, y)``, with ``S x`` and ``S y`` summed element by element."""
         return cls(x, y, system.f - system.internal_forces(x), system.internal_forces(y))
 
     def vectors(self) -> tuple[NDArray, ...]:
-        """Every vector of the state, in field order (a subclass may carry more)."""
+        """Every vector of the state, in field order (the compiled step's ``state``)."""
         return tuple(getattr(self, f.name) for f in fields(self))
 
-    def copy(self) -> State:
+    def copy(self) -> BeamState:
         """A deep copy (every vector copied)."""
         return type(self)(*(v.copy() for v in self.vectors()))
 
-    def permuted(self, order: NDArray) -> State:
+    def permuted(self, order: NDArray) -> BeamState:
         """The state with every vector taken in ``order`` (contiguous copies)."""
         return type(self)(*(np.ascontiguousarray(v[order]) for v in self.vectors()))
 
+    def modal(self) -> list[float]:
+        """The :attr:`MODAL` fields of a one-DOF state, as numbers."""
+        return [float(getattr(self, name)[0]) for name in self.MODAL]
 
-Solve = Callable[[NDArray], NDArray]
 
+def initial_state(
+    scheme: Scheme, system: LinearSystem, state: BeamState, C: sp.spmatrix | None, dt: float
+) -> tuple[BeamState, float]:
+    """The scheme's stepped state from ``(x₀, y₀)``, and what its start adds to the energy
+    the watch allows for.
 
-def reference_step(
-    state: State,
-    k: Increments,
-    system: LinearSystem,
-    solve: Solve,
-    solve_mass: Solve | None,
-    C: sp.spmatrix | None,
-) -> None:
-    """One increment step (module docstring) in NumPy, updating ``state`` in place."""
-    forces = system.internal_forces
-    r = state.q.copy()
-    if C is not None:
-        r -= C @ state.y
-    rhs = r
-    if solve_mass is not None:
-        a = solve_mass(r)
-        rhs = r - k.k_sa * forces(a)
-    dy = solve(k.dt * (rhs - k.k_g * state.g))
-    dx = k.dt * state.y + k.k_dy * dy
-    if solve_mass is not None:
-        dx += k.k_a * a
-    state.x += dx
-    state.y += dy
-    state.q -= forces(dx)
-    if k.k_g:
-        state.g = forces(state.y)
+    A scheme that :attr:`~tumble.structural.scheme.Scheme.carries_acceleration` starts from
+    ``a₀ = M⁻¹ r₀`` (``r₀ = q₀ − C y₀``, SuperLU of ``M``), whose ``Δt²`` terms move ``x``
+    in the first steps: ``½ Δt² a₀ᵀM a₀`` [J] is added to ``V₀``
+    (:mod:`~tumble.structural.divergence`). Otherwise the energy term is 0.
+    """
+    if not scheme.carries_acceleration:
+        return scheme.start(system, state, C, dt, None), 0.0
+    r = state.q - (0.0 if C is None else C @ state.y)
+    a = factorize(system.M)(r)
+    extra = 0.5 * dt * dt * max(float(a @ r), 0.0)
+    return scheme.start(system, state, C, dt, (a, r)), extra
 
 
 class Watched(Stepper):
-    """What every structural stepper shares: the energy check of
+    """What both structural steppers share: the energy check of
     :mod:`tumble.structural.divergence` (:attr:`watch`, made from the initial state by
     :meth:`start`) and the message of a run that failed it."""
 
     system: LinearSystem
     watch: EnergyWatch
     solve: Solve
-    """``A⁻¹`` of the step matrix (``A ≥ M``), for the watch's first bound."""
+    """``A⁻¹`` of the first step matrix (``A ≥ M``), for the watch's first bound."""
     failed_check = False
 
-    def start(self, state: State) -> State:
-        """The stepped state: ``state`` itself, and the watch from it."""
+    def start(self, state: BeamState, acceleration_energy: float = 0.0) -> BeamState:
+        """The stepped state: ``state`` itself, and the watch from it (with
+        ``acceleration_energy``, :func:`initial_state`'s second result)."""
         self.watch = EnergyWatch.start(
-            self.system, state.x, state.y, state.q, self.solve, self.acceleration_energy(state)
+            self.system, state.x, state.y, state.q, self.solve, acceleration_energy
         )
         return state
-
-    def acceleration_energy(self, state: State) -> float:
-        """``½ Δt² a₀ᵀM a₀`` [J] of a scheme that carries the acceleration, else 0
-        (:mod:`~tumble.structural.divergence`: part of what its start supplies)."""
-        return 0.0
 
     def failure(self, t_old: float, t_new: float) -> str:
         if self.failed_check:
@@ -160,23 +130,29 @@ class Watched(Stepper):
         return non_finite_message(t_old, t_new)
 
 
-class Reference(Watched):
-    """A NumPy reference stepper: ``advance(state)`` in place, on a copy of each state, so
-    that a failed step leaves the last good one; the energy checked as in the compiled
-    loops, every :data:`~tumble.structural.divergence.CHECK_EVERY` steps of ``dt``."""
+class ReferenceBeamStepper(Watched):
+    """The NumPy reference of any scheme as a stepper of :func:`tumble.ode.driver.march`:
+    SuperLU of each step matrix, one :meth:`~tumble.structural.scheme.Scheme.step` a step,
+    on a copy of each state (so that a failed step leaves the last good one); the energy
+    checked as in the compiled loop, every :data:`~tumble.structural.divergence.CHECK_EVERY`
+    steps."""
 
-    dt: float
+    def __init__(
+        self, system: LinearSystem, scheme: Scheme, C: sp.spmatrix | None, dt: float,
+        matrices: list[sp.spmatrix],
+    ) -> None:  # fmt: skip
+        self.system, self.scheme, self.C, self.dt = system, scheme, C, dt
+        self.coefficients = scheme.coefficients(dt)
+        self.solves = [factorize(A) for A in matrices]
+        self.solve = self.solves[0]
 
-    def advance(self, state: State) -> None:
-        raise NotImplementedError
-
-    def step(self, t: float, state: State, h: float) -> tuple[State, None]:
+    def step(self, t: float, state: BeamState, h: float) -> tuple[BeamState, None]:
         new = state.copy()
-        self.advance(new)
+        self.scheme.step(new, self.system, self.solves, self.C, self.coefficients)
         self.step_index = round((t + h) / self.dt)
         return new, None
 
-    def finite(self, state: State) -> bool:
+    def finite(self, state: BeamState) -> bool:
         if not all_finite(state.x, state.y):
             return False
         if not self.watch.checks(self.step_index):
@@ -186,57 +162,33 @@ class Reference(Watched):
         self.failed_check = self.watch.exceeds(t, energy) and self.watch.confirms(t, energy)
         return not self.failed_check
 
-    def record(self, state: State) -> tuple:
+    def record(self, state: BeamState) -> tuple:
         return state.x[None].copy(), state.y[None].copy()
 
 
-class ReferenceStepper(Reference):
-    """The NumPy reference as a stepper of :func:`tumble.ode.driver.march`: SuperLU, one
-    :func:`reference_step` a step."""
+class CompiledBeamStepper(Watched):
+    """Any scheme's compiled step in the one time loop
+    (:func:`~tumble.structural.kernels.time_loop`), as a stepper of the driver: blocks of
+    steps compiled, with the banded Cholesky factors of the scheme's step matrices.
 
-    def __init__(self, system: LinearSystem, k: Increments, A: sp.spmatrix, C):
-        self.system, self.k, self.C, self.dt = system, k, C, k.dt
-        self.solve = factorize(A)
-        self.solve_mass = factorize(system.M) if k.mass_solve else None
-
-    def advance(self, state: State) -> None:
-        reference_step(state, self.k, self.system, self.solve, self.solve_mass, self.C)
-
-    def acceleration_energy(self, state: State) -> float:
-        return _acceleration_energy(self.system, state, self.C, self.solve_mass, self.dt)
-
-
-class CompiledStepper(Watched):
-    """:func:`~tumble.structural.kernels.run_steps` as a stepper of the driver: blocks of
-    steps compiled, with the banded Cholesky of :class:`~tumble.structural.factorization.
-    BandedCholesky`.
-
-    Everything is put in the factor's DOF order (``factor.order``) once, so the loop never
-    permutes; :meth:`record` and the blocks' records put it back. A block that meets a
-    non-finite state, or fails the energy check, is replayed from its start to the step
+    Everything is put in the first factor's DOF order (``factor.order``) once, so the loop
+    never permutes; :meth:`record` and the blocks' records put it back. A block that meets
+    a non-finite state, or fails the energy check, is replayed from its start to the step
     before (the same operations, so the same numbers): the run keeps its last good state at
     no cost per step. A check that fails only the first bound (``P_A``, module
     :mod:`~tumble.structural.divergence`) goes on from where it stopped with the true one.
     """
 
     blocks = True
-    solve_mass: Solve | None = None
 
-    def __init__(self, system: LinearSystem, k: Increments, factor: BandedCholesky, C, block):
-        mass = BandedCholesky.from_matrix(system.M, factor.order) if k.mass_solve else factor
-        self.prepare(system, (factor, mass), C, block)
-        self.C, self.solve_mass = C, mass.solve if k.mass_solve else None
-        self.coefficients = (k.dt, k.k_g, k.k_dy, k.k_sa, k.k_a)
-        self.work = tuple(np.zeros(self.order.size) for _ in range(4))
-
-    def prepare(self, system: LinearSystem, factors: tuple[BandedCholesky, ...], C, block) -> None:
-        """What every compiled loop reads, in the first factor's DOF order: the factors
-        (padded to one bandwidth, for which the loop is compiled), the element arrays, the
-        damping matrix as CSR; and the number of steps per block."""
+    def __init__(
+        self, system: LinearSystem, scheme: Scheme, C: sp.spmatrix | None, dt: float,
+        factors: list[BandedCholesky], block: int,
+    ) -> None:  # fmt: skip
         order = factors[0].order
         self.order, self.inverse = order, np.empty_like(order)
         self.inverse[order] = np.arange(order.size)
-        b = max(factor.bandwidth for factor in factors)
+        b = max(factor.bandwidth for factor in factors)  # the loop is compiled for one
         self.factors = tuple(_kernel_factor(_padded(factor, b)) for factor in factors)
         dof_map, *element_arrays = system.elements.kernel_arrays
         permuted_map = np.where(dof_map >= 0, self.inverse[np.maximum(dof_map, 0)], -1)
@@ -244,37 +196,36 @@ class CompiledStepper(Watched):
         self.damping = _csr_arrays(None if C is None else sp.csr_matrix(C)[order][:, order])
         self.block_steps = block
         self.system, self.solve = system, factors[0].solve
+        self.kernel, self.what = scheme.kernel, f"the structural time loop ({scheme.name})"
+        self.coefficients = scheme.coefficients(dt)
+        self.work = tuple(np.zeros(order.size) for _ in range(self.kernel.work))
+        self.lag = self.work[self.kernel.lag] if self.kernel.lag >= 0 else np.zeros(0)
 
-    def start(self, state: State) -> State:
+    def start(self, state: BeamState, acceleration_energy: float = 0.0) -> BeamState:
         """``state`` in the factor's DOF order, and the watch from it."""
-        super().start(state)
+        super().start(state, acceleration_energy)
         return state.permuted(self.order)
 
-    def record(self, state: State) -> tuple:
+    def record(self, state: BeamState) -> tuple:
         return state.x[self.inverse][None], state.y[self.inverse][None]
 
-    def acceleration_energy(self, state: State) -> float:
-        if self.solve_mass is None:
-            return 0.0
-        dt = self.coefficients[0]
-        return _acceleration_energy(self.system, state, self.C, self.solve_mass, dt)
-
-    def _run(self, state: State, k0: int, k1: int, steps: NDArray[np.int64], row: int, xs, ys):
-        vectors = (state.x, state.y, state.q, state.g)
-        announce_compilation(run_steps, "the structural time loop")
-        factor, mass = self.factors
-        return run_steps(k0, k1, steps, row, self.coefficients, vectors, self.frame, factor,
-                         mass, self.damping, self.work, self.checks, xs, ys)  # fmt: skip
+    def _run(self, state: BeamState, k0: int, k1: int, steps: NDArray[np.int64], row: int,
+             xs: NDArray, ys: NDArray) -> tuple[int, int, float]:  # fmt: skip
+        loop = self.kernel.loop
+        announce_compilation(loop, self.what)
+        return loop(k0, k1, steps, row, self.coefficients, state.vectors(), self.frame,
+                    self.factors, self.damping, self.work, self.lag, self.checks, xs,
+                    ys)  # fmt: skip
 
     def march_block(
-        self, state: State, grid: Grid, k0: int, k1: int, every: int, step0: int
+        self, state: BeamState, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
         k = np.arange(k0 + 1, k1 + 1)
         steps = k[(step0 + k) % every == 0]
         n = self.order.size
         xs, ys = np.empty((steps.size + 1, n)), np.empty((steps.size + 1, n))
         start = state.copy()
-        steps_padded = np.append(steps, -1)  # the kernel reads one entry past its last record
+        steps_padded = np.append(steps, -1)  # the loop reads one entry past its last record
         self.checks = self.watch.kernel(self.order)
         rows, failed, energy = self._run(state, k0, k1, steps_padded, 0, xs, ys)
         while failed >= 0 and not energy < 0:  # a failed energy check (-1.0: non-finite)
@@ -290,15 +241,6 @@ class CompiledStepper(Watched):
         return Block(
             times, (xs[:rows][:, self.inverse], ys[:rows][:, self.inverse]), state, failed
         )
-
-
-def _acceleration_energy(system: LinearSystem, state: State, C, solve_mass, dt: float) -> float:
-    """``½ Δt² a₀ᵀM a₀`` with ``M a₀ = q − C y`` for Newmark with ``2β ≠ γ`` (which carries
-    ``a``); 0 without a mass solve."""
-    if solve_mass is None:
-        return 0.0
-    r = state.q - (0.0 if C is None else C @ state.y)
-    return 0.5 * dt * dt * max(float(solve_mass(r) @ r), 0.0)
 
 
 def _kernel_factor(factor: BandedCholesky) -> tuple:
