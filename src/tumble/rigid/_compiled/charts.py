@@ -169,8 +169,9 @@ def _quat_start(z, Rn):
 
 
 @njit(**_INLINE)
-def _quat_advance(z, znew, Rn):
-    """The step's result, ``q`` not yet normalised (:func:`_quat_start` does that)."""
+def _take_new(z, znew, Rn):
+    """``z ← z_new``: the map back of the charts that carry the attitude in ``z`` itself
+    (``matrix``; ``quat``, whose ``q`` is normalised by :func:`_quat_start`)."""
     for q in range(z.shape[0]):
         z[q] = znew[q]
 
@@ -201,12 +202,6 @@ def _matrix_field(problem, zs, Rn, R, K, i):
         K[i, 3 * r + 1] = R[r, 2] * w0 - R[r, 0] * w2
         K[i, 3 * r + 2] = R[r, 0] * w1 - R[r, 1] * w0
     _loads(9, zs, R, 0.0, 0.0, 0.0, 0.0, 0.0, problem, K, i)
-
-
-@njit(**_INLINE)
-def _matrix_advance(z, znew, Rn):
-    for q in range(z.shape[0]):
-        z[q] = znew[q]
 
 
 @njit(**_JIT)
@@ -380,8 +375,8 @@ _ADAPTIVE_WORK = njit(**_INLINE)(bind(_adaptive_work, "_adaptive_work", _work=_W
 
 
 COMPILED: dict[str, CompiledChart] = {
-    "matrix": _for_chart("matrix", _matrix_field, _matrix_advance, _matrix_record),
-    "quat": _for_chart("quat", _quat_field, _quat_advance, _quat_record, _quat_start),
+    "matrix": _for_chart("matrix", _matrix_field, _take_new, _matrix_record),
+    "quat": _for_chart("quat", _quat_field, _take_new, _quat_record, _quat_start),
     "lie": _for_chart(
         "lie", _lie_field, _lie_advance, _lie_record, fsal=_lie_first_same_as_last, adaptive=True
     ),  # fmt: skip

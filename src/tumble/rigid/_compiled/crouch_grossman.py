@@ -50,7 +50,8 @@ def _step(problem, state, work, t, h, settle):
     for i in range(s):
         _copy_matrix(Rn, Ri)
         for j in range(i):
-            _rotate_axis_angle(Ri, W[j, 0], W[j, 1], W[j, 2], h * A[i, j])
+            turn = h * A[i, j]  # the turn's vector scaled first: no overflow in |ω|²
+            _rotate_axis_angle(Ri, turn * W[j, 0], turn * W[j, 1], turn * W[j, 2], 1.0)
         for q in range(9):
             acc = 0.0
             for j in range(i):
@@ -72,7 +73,8 @@ def _step(problem, state, work, t, h, settle):
     if not finite:
         return NON_FINITE
     for j in range(s):
-        _rotate_axis_angle(Rn, W[j, 0], W[j, 1], W[j, 2], h * b[j])
+        turn = h * b[j]
+        _rotate_axis_angle(Rn, turn * W[j, 0], turn * W[j, 1], turn * W[j, 2], 1.0)
     _copy(zs, 0, z)
     return OK
 
