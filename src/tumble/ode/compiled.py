@@ -57,6 +57,7 @@ import numpy as np
 from numba import njit
 
 from tumble.ode import control
+from tumble.ode.contract import FAILURES, MINIMUM_STEP, NON_FINITE, OK
 from tumble.ode.dense import StepInterpolant
 from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Steps
 from tumble.ode.ivp import RungeKutta
@@ -65,12 +66,12 @@ from tumble.ode.tableaux import ButcherTableau
 FIRST_BLOCK, LARGEST_BLOCK = 256, 1 << 16
 """An adaptive block has room for this many steps, doubling at each block up to the second."""
 
-GOING, NON_FINITE, MINIMUM_STEP = 0, 1, 2
-"""How an adaptive block ended: at ``t1``, its record full or ``max_steps`` taken; a
-non-finite accepted state; a step below the minimum."""
-
-FAILURES = {GOING: None, NON_FINITE: "non-finite", MINIMUM_STEP: "minimum-step"}
-"""The codes as :class:`~tumble.ode.driver.AdaptiveBlock` names them."""
+GOING = OK
+"""How an adaptive block ended, in the causes every compiled loop shares
+(:mod:`tumble.ode.contract`): ``GOING`` (``OK``: at ``t1``, its record full or ``max_steps``
+taken), ``NON_FINITE`` (a non-finite accepted state), ``MINIMUM_STEP`` (a step below the
+minimum); :data:`~tumble.ode.contract.FAILURES` names them for the
+:class:`~tumble.ode.driver.AdaptiveBlock`."""
 
 _JIT: dict[str, Any] = dict(cache=True, error_model="numpy")
 _INLINE: dict[str, Any] = dict(_JIT, inline="always")
