@@ -8,7 +8,7 @@ BENCH_STAMP := $(VENV)/.installed-bench
 DEMO ?= t-handle
 RUN_DIR ?= runs/$(DEMO)
 
-.PHONY: demo test portability truth browser bench report lint format clean docs
+.PHONY: demo test portability truth browser bench report lint format clean clean-cache docs
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -84,3 +84,8 @@ format: $(STAMP)
 
 clean:
 	rm -rf $(VENV) runs .pytest_cache .ruff_cache .hypothesis
+
+# numba caches a loop bound from a template (tumble/ode/templates.py) under the template's
+# file, so editing a family's compiled step elsewhere does not invalidate it: drop the cache.
+clean-cache:
+	find src -path '*__pycache__*' \( -name '*.nbi' -o -name '*.nbc' \) -delete
