@@ -289,7 +289,14 @@ def test_a_killed_run_exits_130_and_leaves_no_partial_files(tmp_path, signal_nam
 
     out = tmp_path / "run"
     command = [str(Path(sys.executable).with_name("tumble")), "run", "t-handle", "--out", str(out)]
-    process = subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    # SIGINT as at a terminal even where the tests themselves were started with it ignored
+    # (a background job of a non-interactive shell inherits SIG_IGN, and Python then keeps it)
+    process = subprocess.Popen(
+        command,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and process.poll() is None:
         if out.is_dir() and any(".partial" in f.name for f in out.iterdir()):
