@@ -50,7 +50,6 @@ import math
 import weakref
 from collections.abc import Callable
 from functools import cache
-from typing import Any
 
 import numba
 import numpy as np
@@ -62,6 +61,11 @@ from tumble.ode.dense import StepInterpolant
 from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Steps
 from tumble.ode.ivp import RungeKutta
 from tumble.ode.tableaux import ButcherTableau
+from tumble.ode.templates import GRID_TIME as _GRID_TIME
+from tumble.ode.templates import INLINE as _INLINE
+from tumble.ode.templates import JIT as _JIT
+from tumble.ode.templates import MINIMUM_STEP_OF as _MINIMUM_STEP
+from tumble.ode.templates import STEP_FACTOR as _STEP_FACTOR
 
 FIRST_BLOCK, LARGEST_BLOCK = 256, 1 << 16
 """An adaptive block has room for this many steps, doubling at each block up to the second."""
@@ -73,11 +77,6 @@ taken), ``NON_FINITE`` (a non-finite accepted state), ``MINIMUM_STEP`` (a step b
 minimum); :data:`~tumble.ode.contract.FAILURES` names them for the
 :class:`~tumble.ode.driver.AdaptiveBlock`."""
 
-_JIT: dict[str, Any] = dict(cache=True, error_model="numpy")
-_INLINE: dict[str, Any] = dict(_JIT, inline="always")
-_STEP_FACTOR = njit(**_INLINE)(control.step_factor)
-_MINIMUM_STEP = njit(**_INLINE)(control.minimum_step)
-_GRID_TIME = njit(**_INLINE)(control.grid_time)
 _INITIAL_STEP = njit(**_INLINE)(control.initial_step)
 
 

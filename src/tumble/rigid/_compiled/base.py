@@ -12,19 +12,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
 
-from tumble.ode.templates import NON_FINITE, OK, UNCONVERGED, bind
+from tumble.ode.templates import INLINE as _INLINE
+from tumble.ode.templates import JIT as _JIT
 from tumble.rigid import charts
-
-__all__ = ["NON_FINITE", "OK", "UNCONVERGED", "bind"]  # one set of causes, one binder
-
-
-_JIT: dict[str, Any] = dict(cache=True, error_model="numpy")  # no ZeroDivisionError checks
-_INLINE: dict[str, Any] = dict(_JIT, inline="always")
 
 
 @njit(**_JIT)
