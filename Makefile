@@ -26,8 +26,10 @@ demo: $(STAMP)
 	$(BIN)/tumble run $(DEMO) --out $(RUN_DIR) --force
 
 # tests/viz/test_viz_browser.py loads view.html in a real headless Chromium (Debian's packages).
+# The suite runs on every core (pytest-xdist: JOBS=auto; JOBS=0 runs it in this process).
+JOBS ?= auto
 test: $(STAMP) browser
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n $(JOBS)
 
 # The round-off-sensitive tests again, on arithmetic this CPU does not use by default, so that a
 # tolerance that holds for one CPU only fails here and not on a user's machine: numba compiled
@@ -44,7 +46,7 @@ NPY_DISPATCHED = $(BIN)/python -c "from numpy._core import _multiarray_umath as 
 
 portability: $(STAMP)
 	NUMBA_CPU_NAME=generic NPY_DISABLE_CPU_FEATURES="$$($(NPY_DISPATCHED))" \
-		$(BIN)/python -m pytest -p no:cacheprovider $(PORTABILITY_TESTS)
+		$(BIN)/python -m pytest -n $(JOBS) -p no:cacheprovider $(PORTABILITY_TESTS)
 
 # The truth suite's nightly run: random bodies, spins, loads and steps, many examples each
 # (`make test` runs a fixed, deterministic sample of the same tests).
