@@ -28,6 +28,7 @@ BENCHMARKS = [
     "bench_rigid",
     "bench_adaptive",
     "bench_geometric",
+    "bench_published",
     "bench_structural",
     "bench_ode",
     "bench_import",

@@ -13,7 +13,8 @@ References
 ----------
 .. [1] B. C. Carlson, "Numerical computation of real or complex elliptic integrals",
    Numer. Algorithms 10 (1995) 13–26; DLMF §19.25.
-.. [2] M. Abramowitz, I. A. Stegun, Handbook of Mathematical Functions, §16.4 (AGM).
+.. [2] DLMF §20.2 (θ-functions), 22.2.4 and 22.2.9 (sn, cn of θ), 19.5.5 and OEIS A005797
+   (the nome's series in λ).
 .. [3] L. D. Landau, E. M. Lifshitz, Mechanics, 3rd ed., §37.
 """
 
@@ -27,10 +28,13 @@ from numpy.typing import ArrayLike
 from tumble import _checks
 
 EPS = float(np.finfo(float).eps)
-#: The arithmetic–geometric mean stops when ``c_n ≤ AGM_TOL * a_n`` (one ulp: a and b can
-#: settle on neighbouring floats) or after AGM_MAX_STEPS (m1 = 1e-300 needs about 15).
-AGM_TOL = EPS
+#: The most terms :func:`jacobi_series` takes (m1 = 1e-300 needs about 15; the name is the
+#: arithmetic–geometric mean's, whose steps it capped before the θ-series replaced it).
 AGM_MAX_STEPS = 64
+#: The nome ``q = exp(−πK'/K)`` of ``m`` as a series in ``λ = ½ (1 − √k')/(1 + √k')``:
+#: ``q = λ Σ cᵢ λ⁴ⁱ`` (DLMF 19.5.5's inverse; OEIS A005797). Up to ``m = 8/9`` (λ ≤ 0.134)
+#: the next term, ``3567400 λ²⁹``, is below 1e-18 λ.
+NOME_SERIES = (1.0, 2.0, 15.0, 150.0, 1707.0, 20910.0, 268616.0)
 #: Principal moments closer than this fraction of the largest count as equal (symmetric body).
 SYMMETRY_RTOL = 1e-12
 #: The separatrix test, ``|x − y| ≤ SEPARATRIX_RTOL (x + y)`` with ``Δ = x² − y²``,
@@ -45,11 +49,10 @@ SEPARATRIX_RTOL = 2.0 * EPS
 #: 1 − m below this also counts as the separatrix (K = 347 there; Carlson's R_F overflows
 #: for subnormal arguments).
 M1_MIN = 1e-300
-#: Below this ``1 − m`` the Jacobi functions on [0, K/2] come from their hyperbolic series,
-#: above it from the AGM. The AGM gives ``cn = cos(am)`` to an absolute ε, and on [0, K/2]
-#: ``cn ≥ cn(K/2) = √(k'/(1 + k'))`` (k' = √(1 − m)): its relative error is at most
-#: ``ε √((1 + k')/k')``, no more than 2ε from k' = 1/3 up. Below, the series (whose ratio
-#: of terms, the complementary nome, is at most 7.4e-3 there) keeps every function to a few ε.
+#: Below this ``1 − m`` the Jacobi functions on [0, K/2] come from their hyperbolic series in
+#: the complementary nome (at most 7.4e-3 there), and K, K' from that nome; above it from
+#: the θ-series in the nome q itself (at most 0.134 there: its four terms reach ε), and K
+#: from q. Either keeps every function to a few ε relative.
 M1_SERIES = 1.0 / 9.0
 #: The precession integral Π(−ν) is taken as F + P below this ν, as P alone from it up
 #: (:func:`legendre_integrals`).
@@ -101,7 +104,8 @@ def keeps_first(nu: float) -> bool:
 
 
 def complete_first(m1: float) -> float:
-    """K(m) = R_F(0, m1, 1)."""
+    """K(m) = R_F(0, m1, 1), Carlson's form (the motions take K from :func:`quarter_periods`,
+    which needs no R_F)."""
     from scipy.special import elliprf
 
     return float(elliprf(0.0, m1, 1.0))
@@ -119,23 +123,62 @@ def complete_part(nu: float, m: float, m1: float) -> float:
     return float(n / 3.0 * elliprj(0.0, m1, 1.0, 1.0 + n) + 0.5 * np.pi / g)
 
 
-def jacobi(u: np.ndarray, m: float, m1: float) -> tuple[np.ndarray, ...]:
-    """sn, cn, dn and am of u by the arithmetic–geometric mean (A&S 16.4).
+def nome(m: float, m1: float) -> float:
+    """The nome ``q = exp(−πK'/K)`` of ``m ≤ 8/9``, by its series in
+    ``λ = ½ (1 − √k')/(1 + √k') = ½ m/((1 + k')(1 + √k')²)`` (:data:`NOME_SERIES`); the second
+    form keeps a small m's digits, which ``1 − √k'`` would cancel."""
+    root = np.sqrt(m1)
+    lam = 0.5 * m / ((1.0 + root) * (1.0 + np.sqrt(root)) ** 2)
+    l4 = lam**4
+    total = 0.0
+    for coefficient in reversed(NOME_SERIES):
+        total = total * l4 + coefficient
+    return float(lam * total)
 
-    Accurate for |u| ≤ K(m) to an absolute ε; ``dn = √(cn² + m1 sn²)`` avoids the
-    cancellation in 1 − m sn². Near ``am = π/2`` a small cn is only as good as that absolute
-    ε (it is ``cos(am)``): :func:`jacobi_reduced` keeps its relative accuracy.
+
+def theta_excess(q: float) -> float:
+    """``θ₃(0|q)² − 1 = 4s(1 + s)``, ``s = q + q⁴ + q⁹ + q¹⁶`` (``θ₃(0|q)² = 2K/π``, DLMF 20.2.3
+    and 20.9.2), for ``q ≤ 0.134`` (the next term, q²⁵, is below 1e-21). Kept apart from the
+    1, so that ``K = (π/2)(1 + excess)`` rounds once."""
+    total = ((q**16 + q**9) + q**4) + q
+    return 4.0 * total * (1.0 + total)
+
+
+def quarter_periods(m: float, m1: float) -> tuple[float, float]:
+    """``(K, K')`` of m from the nome of the smaller of m and ``m1 = 1 − m``:
+    ``K = (π/2) θ₃(0|q)²`` from ``m1 = M1_SERIES`` up (``K' = inf`` there: nothing needs it);
+    below, ``K' = (π/2) θ₃(0|q')²`` with ``q' = exp(−πK/K')`` the nome of m1, and
+    ``K = K' ln(1/q')/π = ½ θ₃(0|q')² ln(1/q')``. Each to about an ulp, without R_F."""
+    if m1 >= M1_SERIES:
+        return 0.5 * np.pi + 0.5 * np.pi * theta_excess(nome(m, m1)), np.inf
+    q = nome(m1, m)
+    excess, log = theta_excess(q), -0.5 * np.log(q)
+    return log + log * excess, 0.5 * np.pi + 0.5 * np.pi * excess
+
+
+def jacobi_theta(w: np.ndarray, m: float, m1: float, quarter: float) -> tuple:
+    """sn and cn of ``0 ≤ w ≤ K/2`` up to one common factor, for ``1 − m ≥ M1_SERIES``.
+
+    With ``v = πw/(2K)``, ``sn/cn = θ₁(v)/(√k' θ₂(v))`` (DLMF 22.2.4, 22.2.5 and
+    ``√k' = θ₄(0)/θ₃(0)``), and by DLMF 20.2.1–2 without their common ``2q^¼``:
+    ``θ₁ ∝ sin v − q² sin 3v + q⁶ sin 5v − q¹² sin 7v``,
+    ``θ₂ ∝ cos v + q² cos 3v + q⁶ cos 5v + q¹² cos 7v`` (the next terms, ``q²⁰``, are below
+    ε/9 for ``q ≤ 0.134``). The multiples come from ``sin v``, ``cos v`` by Chebyshev's
+    recurrence; on ``v ≤ π/4`` neither sum cancels, so sn and cn keep a few ε relative.
     """
-    a, b, c = 1.0, np.sqrt(m1), np.sqrt(m)
-    ratios: list[float] = []
-    while c > AGM_TOL * a and len(ratios) < AGM_MAX_STEPS:
-        a, b, c = 0.5 * (a + b), np.sqrt(a * b), 0.5 * (a - b)
-        ratios.append(c / a)
-    phi = 2.0 ** len(ratios) * a * np.asarray(u, dtype=float)
-    for ratio in reversed(ratios):
-        phi = 0.5 * (phi + np.arcsin(ratio * np.sin(phi)))
-    sn, cn = np.sin(phi), np.cos(phi)
-    return sn, cn, np.sqrt(cn * cn + m1 * sn * sn), phi
+    q = nome(m, m1)
+    v = 0.5 * np.pi * np.asarray(w, dtype=float) / quarter
+    s, c = np.sin(v), np.cos(v)
+    two = 2.0 - 4.0 * s * s  # 2 cos 2v
+    s3, c3 = s * (two + 1.0), c * (two - 1.0)
+    s5, c5 = two * s3 - s, two * c3 - c
+    s7, c7 = two * s5 - s3, two * c5 - c3
+    q2 = q * q
+    q4 = q2 * q2
+    q6 = q4 * q2
+    odd = s - q2 * (s3 - q4 * (s5 - q6 * s7))
+    even = c + q2 * (c3 + q4 * (c5 + q6 * c7))
+    return odd, np.sqrt(np.sqrt(m1)) * even
 
 
 def jacobi_series(w: np.ndarray, m: float, quarter: float, co_quarter: float) -> tuple:
@@ -170,18 +213,19 @@ def jacobi_reduced(
     """sn, cn, dn of ``|r| ≤ K``, each to a few ε *relative*: a small cn or dn keeps its
     digits (the exact flow takes them into :func:`legendre_integrals`).
 
-    On ``|r| ≤ K/2`` directly, sn and cn by :func:`jacobi` where ``1 − m ≥ M1_SERIES``, else
-    by :func:`jacobi_series`; beyond, at ``v = K − |r|`` with ``sn(K − v) = cn v/dn v``,
-    ``cn(K − v) = k' sn v/dn v``, ``dn(K − v) = k'/dn v`` (DLMF 22.4.3), k' = √(1 − m). The
-    pair is scaled to ``sn² + cn² = 1`` and ``dn = √(cn² + m1 sn²)``: the three then keep
-    both identities to round-off, so the ω they give lies on the state's own energy and
-    momentum surfaces (without, the energy drifted by about an ulp a step).
+    On ``|r| ≤ K/2`` directly, sn and cn by :func:`jacobi_theta` where ``1 − m ≥ M1_SERIES``
+    (``co_quarter`` is not used there), else by :func:`jacobi_series`; beyond, at
+    ``v = K − |r|`` with ``sn(K − v) = cn v/dn v``, ``cn(K − v) = k' sn v/dn v``,
+    ``dn(K − v) = k'/dn v`` (DLMF 22.4.3), k' = √(1 − m). The pair is scaled to
+    ``sn² + cn² = 1`` and ``dn = √(cn² + m1 sn²)``: the three then keep both identities to
+    round-off, so the ω they give lies on the state's own energy and momentum surfaces
+    (without, the energy drifted by about an ulp a step).
     """
     r = np.asarray(r, dtype=float)
     reflect = np.abs(r) > 0.5 * quarter
     w = np.where(reflect, quarter - np.abs(r), np.abs(r))
     if m1 >= M1_SERIES:
-        s, c, _, _ = jacobi(w, m, m1)
+        s, c = jacobi_theta(w, m, m1, quarter)
     else:
         s, c = jacobi_series(w, m, quarter, co_quarter)
     size = np.hypot(s, c)
@@ -223,8 +267,8 @@ class EllipticMotion:
 
     @property
     def quarter(self) -> float:
-        """K(m), a quarter period of the argument u."""
-        return complete_first(self.m1)
+        """K(m), a quarter period of the argument u (:func:`quarter_periods`)."""
+        return quarter_periods(self.m, self.m1)[0]
 
     @property
     def period(self) -> float:
@@ -234,10 +278,9 @@ class EllipticMotion:
     def functions(self, t: np.ndarray) -> tuple[np.ndarray, ...]:
         """sn, cn, dn of ``r`` and j, for u(t) = 2K j + r with r in [−K, K) (each function
         to a few ε relative, :func:`jacobi_reduced`)."""
-        k = self.quarter
+        k, co_quarter = quarter_periods(self.m, self.m1)
         u = self.u0 + self.rate * t
         j = np.floor((u + k) / (2.0 * k))
-        co_quarter = complete_first(self.m) if self.m1 < M1_SERIES else np.inf
         return (*jacobi_reduced(u - 2.0 * k * j, self.m, self.m1, k, co_quarter), j)
 
     def omega(self, t: np.ndarray) -> np.ndarray:
@@ -321,7 +364,7 @@ def start_phase(sn0: float, cn0: float, m: float, m1: float, nu: float) -> tuple
     s, c = (sn0, cn0) if cn0 >= 0.0 else (-sn0, -cn0)
     first, part = legendre_integrals(s, c * c, c * c + m1 * s * s, nu, m)
     if half:
-        first = first + 2.0 * half * complete_first(m1)
+        first = first + 2.0 * half * quarter_periods(m, m1)[0]
         part = part + 2.0 * half * complete_part(nu, m, m1)
     return float(first), float(part)
 

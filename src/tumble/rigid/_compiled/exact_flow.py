@@ -23,12 +23,16 @@ from tumble.rigid._compiled.charts import _exp_coefficients
 _EPS = 2.220446049250313e-16
 _RF_Q = (3.0 * _EPS) ** (-1.0 / 6.0)
 _RJ_Q = (0.25 * _EPS) ** (-1.0 / 6.0)
+_HALF_PI = 0.5 * math.pi
 SYMMETRY_RTOL, SEPARATRIX_RTOL, M1_MIN, M1_SERIES = 1e-12, 2.0 * _EPS, 1e-300, 1.0 / 9.0
 NU_SPLIT = 1.0
+NOME_SERIES = (1.0, 2.0, 15.0, 150.0, 1707.0, 20910.0, 268616.0)
 """As :mod:`tumble._elliptic`, which derives them (a test checks they agree)."""
 AGM_MAX_STEPS = 64
-WORK_SIZE = AGM_MAX_STEPS
-"""A flow's work array: the AGM's ratios."""
+"""As :data:`tumble._elliptic.AGM_MAX_STEPS`: the most terms the hyperbolic series takes."""
+WORK_SIZE = 1
+"""A flow's work array, in the flows' common signature: the exact flow no longer needs one
+(it held the AGM's ratios, which the nome's θ-series replaced)."""
 
 
 @njit(**_JIT)
@@ -89,20 +93,90 @@ def _carlson_rj(x, y, z, p):
 
 
 @njit(**_JIT)
-def _jacobi(u, m, m1, work):
-    """``(sn, cn, dn, am)`` of ``u`` by the AGM (``tumble._elliptic.jacobi``); ``work`` holds
-    the ratios ``c_n/a_n``."""
-    a, b, c = 1.0, math.sqrt(m1), math.sqrt(m)
-    n = 0
-    while c > _EPS * a and n < AGM_MAX_STEPS:
-        a, b, c = 0.5 * (a + b), math.sqrt(a * b), 0.5 * (a - b)
-        work[n] = c / a
-        n += 1
-    phi = 2.0**n * a * u
-    for k in range(n - 1, -1, -1):
-        phi = 0.5 * (phi + math.asin(work[k] * math.sin(phi)))
-    sn, cn = math.sin(phi), math.cos(phi)
-    return sn, cn, math.sqrt(cn * cn + m1 * sn * sn), phi
+def _carlson_rf_rj(x, y, z, p):
+    """``(R_F(x, y, z), R_J(x, y, z, p))`` by one duplication: R_J's x, y, z steps are R_F's,
+    so the two share their square roots, and the loop runs until both have converged
+    (:func:`_carlson_rf`, :func:`_carlson_rj`)."""
+    a0_f, a0_j = (x + y + z) / 3.0, (x + y + z + 2.0 * p) / 5.0
+    a_f, a_j, scale, total = a0_f, a0_j, 1.0, 0.0
+    delta = (p - x) * (p - y) * (p - z)
+    q_f = _RF_Q * max(abs(a0_f - x), abs(a0_f - y), abs(a0_f - z))
+    q_j = _RJ_Q * max(abs(a0_j - x), abs(a0_j - y), abs(a0_j - z), abs(a0_j - p))
+    x0, y0, z0 = x, y, z
+    while scale * q_f >= abs(a_f) or scale * q_j >= abs(a_j):
+        sx, sy, sz, sp = math.sqrt(x), math.sqrt(y), math.sqrt(z), math.sqrt(p)
+        lam = sx * sy + sx * sz + sy * sz
+        d = (sp + sx) * (sp + sy) * (sp + sz)
+        total += scale / d * _rc_one(scale * scale * scale * delta / (d * d))
+        x, y, z = 0.25 * (x + lam), 0.25 * (y + lam), 0.25 * (z + lam)
+        p, a_f, a_j = 0.25 * (p + lam), 0.25 * (a_f + lam), 0.25 * (a_j + lam)
+        scale *= 0.25
+    X, Y = (a0_f - x0) * scale / a_f, (a0_f - y0) * scale / a_f
+    Z = -X - Y
+    e2, e3 = X * Y - Z * Z, X * Y * Z
+    first = (1.0 - e2 / 10.0 + e3 / 14.0 + e2 * e2 / 24.0 - 3.0 * e2 * e3 / 44.0) / math.sqrt(a_f)
+    X, Y, Z = (a0_j - x0) * scale / a_j, (a0_j - y0) * scale / a_j, (a0_j - z0) * scale / a_j
+    P = -0.5 * (X + Y + Z)
+    e2 = X * Y + X * Z + Y * Z - 3.0 * P * P
+    e3 = X * Y * Z + 2.0 * e2 * P + 4.0 * P * P * P
+    e4 = (2.0 * X * Y * Z + e2 * P + 3.0 * P * P * P) * P
+    e5 = X * Y * Z * P * P
+    series = (1.0 - 3.0 * e2 / 14.0 + e3 / 6.0 + 9.0 * e2 * e2 / 88.0 - 3.0 * e4 / 22.0
+              - 9.0 * e2 * e3 / 52.0 + 3.0 * e5 / 26.0)  # fmt: skip
+    return first, scale * series / (a_j * math.sqrt(a_j)) + 6.0 * total
+
+
+@njit(**_JIT)
+def _nome(m, m1):
+    """The nome ``q = exp(−πK'/K)`` of ``m ≤ 8/9`` by its series in ``λ``
+    (``tumble._elliptic.nome``)."""
+    root = math.sqrt(m1)
+    lam = 0.5 * m / ((1.0 + root) * (1.0 + math.sqrt(root)) ** 2)
+    l4 = lam * lam
+    l4 *= l4
+    total = 0.0
+    for k in range(len(NOME_SERIES) - 1, -1, -1):
+        total = total * l4 + NOME_SERIES[k]
+    return lam * total
+
+
+@njit(**_JIT)
+def _theta_excess(q):
+    """``θ₃(0|q)² − 1`` (``tumble._elliptic.theta_excess``)."""
+    q2 = q * q
+    q4 = q2 * q2
+    total = ((q4 * q4 * q4 * q4 + q4 * q4 * q) + q4) + q
+    return 4.0 * total * (1.0 + total)
+
+
+@njit(**_JIT)
+def _quarter_periods(m, m1):
+    """``(K, K')`` from the nome of the smaller of m and m1 (``tumble._elliptic.
+    quarter_periods``); ``K' = inf`` from ``m1 = M1_SERIES`` up, where nothing needs it."""
+    if m1 >= M1_SERIES:
+        return _HALF_PI + _HALF_PI * _theta_excess(_nome(m, m1)), math.inf
+    q = _nome(m1, m)
+    excess, log = _theta_excess(q), -0.5 * math.log(q)
+    return log + log * excess, _HALF_PI + _HALF_PI * excess
+
+
+@njit(**_JIT)
+def _jacobi_theta(w, m, m1, quarter):
+    """``(sn, cn)`` of ``0 ≤ w ≤ K/2`` up to one factor, for ``1 − m ≥ M1_SERIES``, by the
+    θ-series in the nome (``tumble._elliptic.jacobi_theta``)."""
+    q = _nome(m, m1)
+    v = _HALF_PI * w / quarter
+    s, c = math.sin(v), math.cos(v)
+    two = 2.0 - 4.0 * s * s  # 2 cos 2v
+    s3, c3 = s * (two + 1.0), c * (two - 1.0)
+    s5, c5 = two * s3 - s, two * c3 - c
+    s7, c7 = two * s5 - s3, two * c5 - c3
+    q2 = q * q
+    q4 = q2 * q2
+    q6 = q4 * q2
+    odd = s - q2 * (s3 - q4 * (s5 - q6 * s7))
+    even = c + q2 * (c3 + q4 * (c5 + q6 * c7))
+    return odd, math.sqrt(math.sqrt(m1)) * even
 
 
 @njit(**_JIT)
@@ -125,13 +199,14 @@ def _jacobi_series(w, m, quarter, co_quarter):
 @njit(**_JIT)
 def _jacobi_reduced(r, m, m1, quarter, co_quarter, work):
     """``(sn, cn, dn)`` of ``|r| ≤ K``, each to a few ε relative and together on both
-    identities (``tumble._elliptic.jacobi_reduced``: beyond K/2 by the reflection about K)."""
+    identities (``tumble._elliptic.jacobi_reduced``: beyond K/2 by the reflection about K).
+    ``co_quarter`` is K' (the hyperbolic series'); ``work`` is not used."""
     w = abs(r)
     reflect = w > 0.5 * quarter
     if reflect:
         w = quarter - w
     if m1 >= M1_SERIES:
-        s, c, _, _ = _jacobi(w, m, m1, work)
+        s, c = _jacobi_theta(w, m, m1, quarter)
     else:
         s, c = _jacobi_series(w, m, quarter, co_quarter)
     size = math.hypot(s, c)
@@ -148,13 +223,26 @@ def _legendre_integrals(s, c2, d2, nu, m):
     """``(F(φ|m), P)`` from ``s, cn², dn²``: ``Π(−ν; φ|m) = F + P`` for ``ν < 1``, ``= P``
     from 1 up (``tumble._elliptic.legendre_integrals``)."""
     r2 = s * s + c2
-    first = s * _carlson_rf(c2, d2, r2)
     if nu < NU_SPLIT:
-        return first, -nu / 3.0 * s * s * s * _carlson_rj(c2, d2, r2, r2 + nu * s * s)
+        first, third = _carlson_rf_rj(c2, d2, r2, r2 + nu * s * s)
+        return s * first, -nu / 3.0 * s * s * s * third
     n = m / nu
     g = math.sqrt((1.0 + nu) * (1.0 + n))
     turn = math.atan2(g * s * math.sqrt(r2), math.sqrt(c2 * d2)) / g
-    return first, n / 3.0 * s * s * s * _carlson_rj(c2, d2, r2, r2 + n * s * s) + turn
+    first, third = _carlson_rf_rj(c2, d2, r2, r2 + n * s * s)
+    return s * first, n / 3.0 * s * s * s * third + turn
+
+
+@njit(**_JIT)
+def _legendre_part(s, c2, d2, nu, m):
+    """The part P of :func:`_legendre_integrals` alone (no R_F)."""
+    r2 = s * s + c2
+    if nu < NU_SPLIT:
+        return -nu / 3.0 * s * s * s * _carlson_rj(c2, d2, r2, r2 + nu * s * s)
+    n = m / nu
+    g = math.sqrt((1.0 + nu) * (1.0 + n))
+    turn = math.atan2(g * s * math.sqrt(r2), math.sqrt(c2 * d2)) / g
+    return n / 3.0 * s * s * s * _carlson_rj(c2, d2, r2, r2 + n * s * s) + turn
 
 
 @njit(**_JIT)
@@ -172,24 +260,26 @@ def _elliptic_step(wb, other_w, pole_w, amplitudes, rate, m, m_1, nu, h, work):
     """The elliptic motion from ω over ``h``: ``(ω_other, ω_B, ω_pole)`` at ``h`` and the
     difference over the step of the precession integral's part P (``Π(−ν; am u) = F + P``
     for ``ν < 1``, ``= P`` from 1 up; ``tumble._elliptic``'s ``elliptic_motion``,
-    ``start_phase``, ``EllipticMotion.omega`` and ``precession``)."""
+    ``start_phase``, ``EllipticMotion.omega`` and ``precession``). The start's
+    ``u0 = F + 2K·half`` and ``P + 2P(π/2)·half`` (``half`` = ±1 when ``cn u0 < 0``) and the
+    end's ``2Kj + r``: the complete P enters as ``(j − half)·2P(π/2)``, computed only when a
+    step passes a half period (``j ≠ half``)."""
     amp_other, amp_b, amp_pole = amplitudes
     sign = 1.0 if pole_w > 0.0 else -1.0
     cn0 = other_w / amp_other if amp_other > 0.0 else 1.0
     sn0 = sign * wb / amp_b if amp_b > 0.0 else 0.0
-    quarter = _carlson_rf(0.0, m_1, 1.0)
-    full = 2.0 * _complete_part(nu, m, m_1)  # P of 2Π(−ν|m)
+    quarter, co_quarter = _quarter_periods(m, m_1)
     half = 0.0 if cn0 >= 0.0 else (1.0 if sn0 >= 0.0 else -1.0)
     s, c = (sn0, cn0) if cn0 >= 0.0 else (-sn0, -cn0)
     u0, start = _legendre_integrals(s, c * c, c * c + m_1 * s * s, nu, m)
-    u0, start = u0 + 2.0 * half * quarter, start + half * full
-    co_quarter = _carlson_rf(0.0, m, 1.0) if m_1 < M1_SERIES else math.inf
-    u = u0 + rate * h
+    u = u0 + 2.0 * half * quarter + rate * h
     j = math.floor((u + quarter) / (2.0 * quarter))
     sn, cn, dn = _jacobi_reduced(u - 2.0 * quarter * j, m, m_1, quarter, co_quarter, work)
     flip = 1.0 - 2.0 * (j - 2.0 * math.floor(0.5 * j))
-    part = _legendre_integrals(sn, cn * cn, dn * dn, nu, m)[1] + j * full
-    return amp_other * flip * cn, sign * amp_b * flip * sn, sign * amp_pole * dn, part - start
+    part = _legendre_part(sn, cn * cn, dn * dn, nu, m) - start
+    if j != half:  # the half periods passed: P of 2Π(−ν|m) each
+        part += (j - half) * 2.0 * _complete_part(nu, m, m_1)
+    return amp_other * flip * cn, sign * amp_b * flip * sn, sign * amp_pole * dn, part
 
 
 @njit(**_JIT)
