@@ -343,7 +343,14 @@ Grid = Annotated[
 
 @app.command()
 def sweep(
-    file: Annotated[Path, typer.Argument(help="A scenario file (.toml).")],
+    scenario: Annotated[
+        str,
+        typer.Argument(
+            metavar="NAME|FILE.toml",
+            help="A scenario file (.toml; rigid-body or a built-in's) or a built-in scenario's "
+            "name (tumble list; its summary's numbers are stored per member).",
+        ),
+    ],
     grid: Grid = None,
     out: Annotated[Path, typer.Option(help="The Zarr store to write (a folder).")] = Path(
         "runs/sweep.zarr"
@@ -352,7 +359,7 @@ def sweep(
         str | None, typer.Option(help="A Dask scheduler's address (default: a local cluster).")
     ] = None,
     resume: Annotated[
-        bool, typer.Option(help="Complete an existing store of this sweep.")
+        bool, typer.Option("--resume", help="Complete an existing store of this sweep.")
     ] = False,
     chunk: Annotated[int | None, typer.Option(help="Members per task.")] = None,
     timeout: Annotated[float, typer.Option(help="Seconds to wait for --scheduler.")] = 10.0,
@@ -361,42 +368,113 @@ def sweep(
         typer.Option(
             "--map",
             help="Draw this summary variable over the two swept dimensions: flip_period "
-            "(default), energy_error, wall_time, status, n_steps.",
+            "(default), energy_error, wall_time, status, n_steps; for a built-in, a number of "
+            "its summary.",
         ),
     ] = None,
+    verbose: Annotated[
+        bool, typer.Option("--verbose", help="Show Dask's own log lines (quiet by default).")
+    ] = False,
 ) -> None:
-    """Run a scenario over a grid of options on Dask, into one Zarr store."""
+    """Run a scenario over a grid of options on Dask, into one Zarr store (and draw a map)."""
+    from tumble.sweeps import Interrupted
     from tumble.sweeps import sweep as run_sweep
-    from tumble.sweeps.picture import draw_map, map_variable
+    from tumble.sweeps.picture import check_map
     from tumble.sweeps.text import grid_from_arguments
 
-    with _reported():
+    def on_plan(plan, estimate) -> None:
+        if draw:
+            check_map(plan, draw, "--map")
+        console.print(f"sweep: {estimate.text()}", highlight=False, soft_wrap=True)
+
+    with _reported(), _dask_quiet(verbose):
         values = grid_from_arguments(grid or [])
-        bar = Progress(TextColumn("sweep"), BarColumn(), TextColumn("{task.completed}/"
-                       "{task.total} members"), TimeElapsedColumn(), console=console,
-                       disable=not console.is_terminal)  # fmt: skip
-        with bar:
-            task = bar.add_task("members", total=None)
-            dataset = run_sweep(
-                str(file), values, client=scheduler, store=out, chunk=chunk,
-                resume=resume, timeout=timeout,
-                progress=lambda done, total: bar.update(task, completed=done, total=total),
-            )  # fmt: skip
-        done = dataset["done"].values
-        table = Table(title=f"sweep: {out}", box=None, show_header=False)
-        table.add_row("members", f"{done.size} ({' x '.join(map(str, done.shape))})")
-        if "status" in dataset:
-            status = dataset["status"].values
-            table.add_row("reached t_end", str(int((status == 0).sum())))
-            table.add_row("stopped (failed)", str(int((status < 0).sum())))
-        table.add_row("wall time of the members", f"{float(dataset['wall_time'].sum()):.3g} s")
-        console.print(table)
-        name, note = map_variable(dataset, draw)
-        if note:
-            console.print(note)
-        if name is not None:
-            picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
-            console.print(f"map: {picture}", highlight=False)
+        try:
+            with _members_bar() as progress:
+                run_sweep(
+                    scenario, values, client=scheduler, store=out, chunk=chunk, resume=resume,
+                    timeout=timeout, progress=progress, on_plan=on_plan,
+                )  # fmt: skip
+        except Interrupted as stopped:  # after the bar is gone
+            errors.print(str(stopped).replace("resume=True", "`--resume`"),
+                         markup=False, highlight=False, soft_wrap=True)  # fmt: skip
+            raise typer.Exit(code=130) from None
+        _show_sweep(out, draw)
+
+
+@contextmanager
+def _members_bar() -> Iterator[Callable[[int, int], None]]:
+    """The sweep's display: what it is doing (the library's status messages), then its bar
+    of members, counted from the first count on (never "0/None members")."""
+    bar = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
+                   TextColumn("{task.fields[counts]}"), TimeElapsedColumn(), console=console,
+                   transient=True, disable=not console.is_terminal)  # fmt: skip
+    with bar:
+        task = bar.add_task("sweep: checking the plan", total=None, counts="")
+        started: list[bool] = []
+
+        def progress(done: int, total: int) -> None:
+            started.append(True)
+            bar.update(task, description="sweep", completed=done, total=total,
+                       counts=f"{done}/{total} members")  # fmt: skip
+
+        def note(stage: str) -> None:
+            if not started:  # then the bar says it all
+                bar.update(task, description=f"sweep: {stage.removeprefix('sweep: ')}")
+
+        with _status_from_log(note):
+            yield progress
+
+
+@contextmanager
+def _dask_quiet(verbose: bool) -> Iterator[None]:
+    """Dask's log lines off (a recovered worker is not an error to the user) unless
+    ``verbose``: in this process, and in the local workers it starts (they read the level
+    from the environment when they import distributed)."""
+    import os
+
+    if verbose:
+        yield
+        return
+    loggers = [logging.getLogger(name) for name in ("distributed", "tornado", "bokeh")]
+    levels = [logger.level for logger in loggers]
+    before = os.environ.get("DASK_LOGGING__DISTRIBUTED")
+    os.environ["DASK_LOGGING__DISTRIBUTED"] = "critical"
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels, strict=True):
+            logger.setLevel(level)
+        if before is None:
+            os.environ.pop("DASK_LOGGING__DISTRIBUTED", None)
+        else:
+            os.environ["DASK_LOGGING__DISTRIBUTED"] = before
+
+
+def _show_sweep(out: Path, draw: str | None) -> None:
+    """The sweep's table (members, how they ended, their time) and its map."""
+    import xarray as xr
+
+    from tumble.sweeps.picture import draw_map, map_variable
+
+    dataset = xr.open_zarr(out, chunks=None)  # numpy, not dask: one read per variable
+    done = dataset["done"].values
+    table = Table(title=f"sweep: {out}", box=None, show_header=False)
+    table.add_row("members", f"{done.size} ({' x '.join(map(str, done.shape))})")
+    if "status" in dataset:
+        status = dataset["status"].values
+        table.add_row("reached t_end", str(int((status == 0).sum())))
+        table.add_row("stopped (failed)", str(int((status < 0).sum())))
+    table.add_row("wall time of the members", f"{float(dataset['wall_time'].sum()):.3g} s")
+    console.print(table)
+    name, note = map_variable(dataset, draw)
+    if note:
+        console.print(note)
+    if name is not None:
+        picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
+        console.print(f"map: {picture}", highlight=False)
 
 
 @app.command()

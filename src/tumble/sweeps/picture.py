@@ -21,6 +21,27 @@ NO_PERIOD = ("no flip period measured (fewer than three crossings): no map; run 
 """Why ``tumble sweep`` draws no default map when no member measured a period."""
 
 
+def check_map(plan, variable: str, name: str = "map") -> None:
+    """Refuse ``--map variable`` before the sweep runs: a per-member variable of ``plan``'s
+    store, over exactly two swept dimensions (:func:`draw_map`'s conditions).
+
+    ``plan`` is a :class:`~tumble.sweeps.plan.Plan` whose outputs are named (a built-in's
+    :attr:`~tumble.sweeps.plan.Plan.outputs`).
+    """
+    from tumble.sweeps.plan import RIGID
+    from tumble.sweeps.variables import SUMMARY, WALL_TIME
+
+    names = list(SUMMARY) if plan.scenario == RIGID else [*plan.outputs, WALL_TIME]
+    _checks.choice(name, variable, names)
+    swept = [name for name, n in zip(plan.dims, plan.shape, strict=True) if n > 1]
+    if plan.samples or len(swept) != 2:
+        raise _checks.fail(
+            name, variable, "drawn over exactly two swept dimensions",
+            remedy=f"this sweep has {0 if plan.samples else len(swept)}: "
+            f"{'none (a table of samples)' if plan.samples else ', '.join(swept) or 'none'}",
+        )  # fmt: skip
+
+
 def map_variable(dataset, requested: str | None) -> tuple[str | None, str]:
     """``(variable to draw or None, a note why none)`` for ``tumble sweep --map``.
 
