@@ -27,8 +27,8 @@ from tumble.sweeps.variables import VARIABLES, WALL_TIME, member_bytes
 
 TASK_CLIENT_BYTES = 20_000
 """The client's memory per task (bytes): its future, its key and the scheduler's state for
-it. Measured: 2000 and 20000 tasks of one member added 9 and 11 kB a task to the peak
-resident memory of the process running a local cluster's scheduler; doubled for margin."""
+it. Measured: 2000 and 20000 tasks added 16 and 13 kB a task to the resident memory of the
+process that holds them and a local cluster's scheduler; rounded up."""
 MEMBER_CLIENT_BYTES = 16
 """The client's memory per member (bytes): the done flags read on resume and at the end, as
 uint8 and as booleans, and the summary the command line prints (status, int8)."""

@@ -70,8 +70,8 @@ def template(plan: Plan):
     (xarray.Dataset, dict)
         The dataset and its ``to_zarr`` encoding (``{name: {"chunks": …}}``). The dask arrays
         are one chunk each: the store's chunks come from the encoding, so writing the
-        template builds no graph of one task per block (2000 tasks took 47 s and 125 MB
-        that way, measured; now a fraction of a second whatever the count).
+        template builds no graph of one task per block (measured, 2000 tasks of a series
+        sweep: 6.0 s that way, 0.24 s this way).
     """
     import dask.array as da
     import xarray as xr
@@ -170,8 +170,8 @@ def check_existing(plan: Plan, store: str | Path) -> None:
 
 
 def done_flags(store: str | Path) -> np.ndarray:
-    """The members' ``done`` flags as booleans, read straight from their Zarr array (through
-    xarray's dask array, a store of 20000 tasks took 100 s to read, measured)."""
+    """The members' ``done`` flags as booleans, read straight from their Zarr array (20000
+    tasks, measured: 11 s, against 36 s through xarray's dask array, one task a chunk)."""
     import zarr
 
     flags = zarr.open_array(Path(store) / "done", mode="r", zarr_format=FORMAT)
