@@ -279,6 +279,28 @@ def test_run_with_mp4_adds_animation_mp4(tmp_path):
     assert "animation.mp4" in json.loads((out / "summary.json").read_text())["files"]
 
 
+def test_mp4_without_the_animation_writes_the_mp4_alone(tmp_path):
+    out = tmp_path / "spin"
+    args = ["run", "t-handle", "--t-end", "2", "--mp4", "--no-animation", "--out", str(out)]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    files = json.loads((out / "summary.json").read_text())["files"]
+    assert "animation.mp4" in files
+    assert "animation.gif" not in files and "view.html" not in files
+    assert (out / "animation.mp4").stat().st_size > 1000
+
+
+def test_mp4_for_a_scenario_without_an_animation_exits_2_before_writing(tmp_path):
+    out = tmp_path / "p"
+    result = runner.invoke(app, ["run", "projectile", "--mp4", "--out", str(out)])
+    assert result.exit_code == 2
+    assert (
+        "mp4=True is not allowed: must be given only for a result with an animation; "
+        "'projectile' draws none; leave out --mp4" in " ".join(result.output.split())
+    )
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("signal_name", ["SIGTERM", "SIGINT"])
 def test_a_killed_run_exits_130_and_leaves_no_partial_files(tmp_path, signal_name):
     # Wait until a file is being written, then stop the run as a scheduler or Ctrl-C would.
