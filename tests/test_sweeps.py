@@ -530,3 +530,30 @@ def test_cli_bar_counts_members_from_its_first_count(monkeypatch):
         progress(4, 4)
     assert "None" not in screen.getvalue()
     assert "4/4 members" in screen.getvalue()
+
+
+@pytest.mark.parametrize(
+    ("dim", "path", "label"),
+    [
+        ("omega0.1", "initial.omega0.1", "ω_y (rad/s)"),
+        ("L0.2", "initial.L0.2", "L_z (kg m²/s)"),
+        ("spins.0.1", "spins.0.1", "ω_y of spins[0] (rad/s)"),
+        ("h", "h", "h (s)"),
+        ("method", "method", "method"),
+        ("body.density", "body.density", "body.density"),
+    ],
+)
+def test_sweep_maps_label_their_axes_with_a_short_name_and_unit(dim, path, label):
+    from tumble.sweeps.picture import axis_label
+
+    dataset = xr.Dataset(coords={dim: (dim, [1.0, 2.0], {"option_path": path})})
+    assert axis_label(dataset, dim) == label
+
+
+def test_the_gallery_card_of_the_flip_map_shows_its_picture():
+    """flip_map.py is not run by the gallery (a cluster): its thumbnail and its page show
+    docs/img/flip_map.png, the picture it draws."""
+    source = (EXAMPLES / "flip_map.py").read_text(encoding="utf-8")
+    assert '# sphinx_gallery_thumbnail_path = "img/flip_map.png"' in source
+    assert ".. image:: /img/flip_map.png" in source
+    assert (EXAMPLES.parent / "docs" / "img" / "flip_map.png").stat().st_size > 20_000

@@ -27,6 +27,24 @@ from tumble import scenarios
 from tumble.io import write_run_folder
 from tumble.scenarios import ScenarioResult
 
+
+def _flags_take_no_value() -> None:
+    """Show no type after a flag in ``--help`` (typer 0.29 prints ``--quick <bool>``, as if a
+    flag took a value; ``--help`` itself too): options that are flags return no type."""
+    option = getattr(getattr(typer, "core", None), "TyperOption", None)
+    shown = getattr(option, "display_type_rich", None)
+    if shown is None or getattr(shown, "flags_take_no_value", False):
+        return
+
+    def display_type_rich(self: Any, ctx: Any) -> str | None:
+        return None if getattr(self, "is_flag", False) else shown(self, ctx)
+
+    display_type_rich.flags_take_no_value = True  # type: ignore[attr-defined]
+    option.display_type_rich = display_type_rich  # type: ignore[union-attr]
+
+
+_flags_take_no_value()
+
 app = typer.Typer(
     help="Simulate rigid bodies and vibrating structures; write run folders.",
     no_args_is_help=True,
@@ -549,7 +567,8 @@ def report_card(
     """The integrator report card: every method measured on the same problems, peers beside."""
     from tumble.report_card import report
 
-    with _reported():
+    # the bar names the compiling phase; the kernels' own notices would scroll past it
+    with _reported(), _status_from_log(lambda stage: None):
         card = report(out, quick=quick, progress=console.is_terminal)
     table = Table(title=f"report card: {len(card.results)} methods in {card.seconds:.0f} s",
                   box=None)  # fmt: skip
@@ -562,6 +581,11 @@ def report_card(
             "[red]contradicted[/]" if result.contradictions else "agrees",
         )  # fmt: skip
     console.print(table)
+    skipped: dict[str, list[str]] = {}
+    for peer, reason in card.skipped.items():
+        skipped.setdefault(reason, []).append(peer)
+    for reason, peers in skipped.items():
+        console.print(f"{', '.join(peers)}: {reason}", highlight=False)
     for name, why in card.contradictions.items():
         errors.print(f"contradiction: {name}:", style="bold red", end=" ")
         errors.print("; ".join(why), markup=False, highlight=False, soft_wrap=True)

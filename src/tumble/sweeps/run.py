@@ -45,6 +45,13 @@ def run_task(plan: Plan, store: str, task: tuple[int, ...]) -> int:
     return len(indices)
 
 
+def _probe(plan: Plan, index: tuple[int, ...]) -> list[str]:
+    """A first run's summary numbers (:func:`~tumble.sweeps.members.summary_names`), as a
+    Dask worker runs it."""
+    with _threads():
+        return summary_names(plan, index)
+
+
 @contextmanager
 def _threads():
     """Numba's threads on a Dask worker: the worker's own (one worker a core), not every core."""
@@ -56,6 +63,9 @@ def _threads():
     except ValueError:  # not on a worker (called directly): leave numba's default
         yield
         return
+    # the client says what the sweep is doing: a worker's word of its kernels compiling
+    # would scroll over the client's bar (the workers share its terminal)
+    logging.getLogger("tumble.compile").setLevel(logging.WARNING)
     before = numba.get_num_threads()
     numba.set_num_threads(max(1, min(wanted, numba.config.NUMBA_NUM_THREADS)))
     try:
@@ -255,7 +265,7 @@ def _named(plan: Plan, dask_client: Any) -> Plan:
     first = probes(plan)
     log.info("sweep: running %d first member(s) to name the summary's numbers", len(first))
     shared = dask_client.scatter(plan, broadcast=True)
-    futures = [dask_client.submit(summary_names, shared, index, pure=False) for index in first]
+    futures = [dask_client.submit(_probe, shared, index, pure=False) for index in first]
     skipped = echoes(plan)
     names: dict[str, None] = {}
     for found in dask_client.gather(futures):
