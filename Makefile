@@ -22,8 +22,15 @@ $(BENCH_STAMP): pyproject.toml $(STAMP)
 	$(BIN)/python -m pip install -q -e ".[dev,bench]"
 	touch $@
 
+# The demo's run compiles simulate's loop; numba compiles simulate_batch's on its first call
+# (15 s on a shared 2-core machine), so the demo compiles it too: later first calls load it
+# from numba's cache in about 2 s.
+WARM_BATCH = import tumble; tumble.simulate_batch(tumble.RigidBody.from_mass_properties( \
+	tumble.mass.t_handle()), 0.02, h=0.01, omega0=[[1.0, 0.05, 0.0]])
+
 demo: $(STAMP)
 	$(BIN)/tumble run $(DEMO) --out $(RUN_DIR) --force
+	$(BIN)/python -c "$(WARM_BATCH)"
 
 # tests/viz/test_viz_browser.py loads view.html in a real headless Chromium (Debian's packages).
 # The suite runs on every core (pytest-xdist: JOBS=auto; JOBS=0 runs it in this process).

@@ -3,6 +3,7 @@
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -157,6 +158,19 @@ def test_mass_of_a_torus_mesh(tmp_path):
     assert abs(mass / (2 * 4.934802) - 1) < 0.01  # 2π²Rr² ρ; the polyhedron is a little smaller
 
 
+def test_mass_of_the_example_bracket_is_its_closed_form():
+    """examples/bracket.stl, the README's mesh: an L of 40 x 5 and 5 x 25 mm, 20 mm wide."""
+    bracket = Path(__file__).parents[1] / "examples" / "bracket.stl"
+    result = runner.invoke(app, ["mass", str(bracket), "--density", "7850"])
+    assert result.exit_code == 0, result.output
+    volume = (40 * 5 + 5 * 25) * 20 * 1e-9  # m³
+    com = np.array([(200 * 20 + 125 * 2.5) / 325, (200 * 2.5 + 125 * 17.5) / 325, 10]) / 1e3
+    rows = {line.split()[0]: line.split() for line in result.output.splitlines() if line}
+    assert float(rows["volume"][2]) == pytest.approx(volume, rel=1e-6)  # printed to 6 digits
+    assert float(rows["mass"][2]) == pytest.approx(7850 * volume, rel=1e-6)
+    np.testing.assert_allclose([float(v) for v in rows["centre"][4:7]], com, rtol=1e-5)
+
+
 def test_mass_rejects_bad_density_and_missing_files(tmp_path):
     from tumble import meshes
 
@@ -171,6 +185,17 @@ def test_every_command_has_help():
     for command in ("list", "run", "compare", "stability", "view", "mass"):
         result = runner.invoke(app, [command, "--help"])
         assert result.exit_code == 0 and "Usage" in result.output
+
+
+def test_flags_show_no_value_in_the_help():
+    """A flag takes no value: its help line shows none (typer would print `--quick <bool>`)."""
+    import typer.main
+
+    for name in [c.name for c in typer.main.get_command(app).commands.values()]:
+        result = runner.invoke(app, [name, "--help"], terminal_width=120)
+        assert result.exit_code == 0, name
+        assert "<bool>" not in result.output, (name, result.output)
+    assert "<path>" in runner.invoke(app, ["report", "--help"], terminal_width=120).output
 
 
 BAD_FILES = {
@@ -277,6 +302,28 @@ def test_run_with_mp4_adds_animation_mp4(tmp_path):
         assert file.read(12)[4:8] == b"ftyp"
     assert (out / "animation.gif").exists()
     assert "animation.mp4" in json.loads((out / "summary.json").read_text())["files"]
+
+
+def test_mp4_without_the_animation_writes_the_mp4_alone(tmp_path):
+    out = tmp_path / "spin"
+    args = ["run", "t-handle", "--t-end", "2", "--mp4", "--no-animation", "--out", str(out)]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    files = json.loads((out / "summary.json").read_text())["files"]
+    assert "animation.mp4" in files
+    assert "animation.gif" not in files and "view.html" not in files
+    assert (out / "animation.mp4").stat().st_size > 1000
+
+
+def test_mp4_for_a_scenario_without_an_animation_exits_2_before_writing(tmp_path):
+    out = tmp_path / "p"
+    result = runner.invoke(app, ["run", "projectile", "--mp4", "--out", str(out)])
+    assert result.exit_code == 2
+    assert (
+        "mp4=True is not allowed: must be given only for a result with an animation; "
+        "'projectile' draws none; leave out --mp4" in " ".join(result.output.split())
+    )
+    assert not out.exists()
 
 
 @pytest.mark.parametrize("signal_name", ["SIGTERM", "SIGINT"])

@@ -131,6 +131,6 @@ def test_a_kernels_first_call_is_announced_once(caplog):
         announce_compilation(kernel, "the test kernel")
         kernel(1.0)
         announce_compilation(kernel, "the test kernel")
-    messages = [r.getMessage() for r in caplog.records if r.name == "tumble"]
-    assert len(messages) == 1 and "a few seconds the first time" in messages[0]
-    assert messages[0].startswith("preparing the test kernel, compiled by numba")  # one article
+    messages = [r.getMessage() for r in caplog.records if r.name == "tumble.compile"]
+    assert len(messages) == 1 and "compiled on the first call after installation" in messages[0]
+    assert messages[0].startswith("preparing the test kernel (numba: ")  # one article

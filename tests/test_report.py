@@ -147,6 +147,89 @@ def test_a_wrong_conservation_claim_is_flagged(monkeypatch):
     assert card.results[0].free.energy_max > report_card.ROUND_OFF
 
 
+def test_the_methods_of_the_figure_can_be_told_apart(folder):
+    """Every method that agrees has its own colour, dash and marker (19+ methods on nine
+    colours: the dash and the marker change with each nine)."""
+    from tumble.viz.report_card import PALETTE, style
+
+    styles = [style(k) for k in range(len(METHODS) + 4)]
+    assert len(set(styles)) == len(styles)
+    assert FLAG not in PALETTE
+    page = (folder / "report.html").read_text(encoding="utf-8")
+    drawn = {(m["legendgroup"], m["line"]["color"], m["line"].get("dash"), m["marker"]["symbol"])
+             for m in _traces(page) if m.get("legendgroup") not in (None, "pareto")}  # fmt: skip
+    assert len({d[1:] for d in drawn}) == len({d[0] for d in drawn}) >= len(METHODS)
+
+
+def _traces(page: str) -> list[dict]:
+    """The traces plotly was given, read back from the page's JSON."""
+    import json
+    import re
+
+    found = re.search(r"Plotly\.newPlot\(\s*\"[^\"]+\",\s*(\[.*?\]),\s*\{", page, re.DOTALL)
+    assert found, "no Plotly.newPlot call in the page"
+    return json.loads(found.group(1))
+
+
+def test_report_html_stands_alone_with_the_verdict_tables(folder):
+    page = (folder / "report.html").read_text(encoding="utf-8")
+    tables = page[page.index('<div id="report-tables">') :]
+    for heading in ("Contradictions", "Order", "Orientation error at T",
+                    "Invariants over a long run", "Cost", "Structural schemes"):  # fmt: skip
+        assert f"<h2>{heading}</h2>" in tables, heading
+    for name in METHODS:
+        assert f"<tr><td>{name}</td>" in tables, name
+
+
+def test_the_report_says_why_euler_quat_and_lie_euler_agree(folder, numbers):
+    text = (folder / "report.md").read_text(encoding="utf-8")
+    assert "Why `euler-quat` and `lie-euler` show the same errors" in text
+    errors = numbers["errors"]["error"].values
+    names = list(numbers["errors"]["method"].values)
+    quat, lie = errors[names.index("euler-quat")], errors[names.index("lie-euler")]
+    assert np.all(np.abs(quat / lie - 1) < 0.05)  # measured: 3e-6 to 2.8 %
+
+
+def test_a_short_run_is_timed_over_spans_of_t_so_the_steps_cost_shows(monkeypatch):
+    """A run that took about the call's fixed cost is timed again over k spans of T in one
+    call and counted as 1/k of it; a long run keeps its time; a failing one too."""
+    from tumble.report_card import measure
+
+    fixed, step_cost = 50e-6, 2e-6  # a compiled method's call, and its 10 steps over T
+    calls = []
+
+    def fake(row, problem, setting, *, t_end=None, samples=0):
+        spans = round(t_end / problem.t_end)
+        calls.append(spans)
+        return report_card.Sampled(np.zeros(1), np.eye(3), np.ones(1), np.ones(1), 0.0,
+                                   math.nan, 10 * spans, fixed + spans * step_cost,
+                                   ok=spans < 500)  # fmt: skip
+
+    monkeypatch.setattr(measure, "run_row", fake)
+    p1 = report_card.problems()[0]
+    row = report_card.method_row(METHODS["rkmk4"])
+    seconds = measure.amortised_seconds(row, p1, 1.0, fixed + step_cost, fixed)
+    assert calls == [math.ceil(measure.AMORTISE * fixed / (fixed + step_cost))]  # 97 spans
+    assert seconds == pytest.approx(step_cost + fixed / calls[0])
+    assert measure.amortised_seconds(row, p1, 1.0, 1.0, fixed) == 1.0  # long: as it was
+    assert measure.amortised_seconds(row, p1, 1.0, 1e-7, fixed) == 1e-7  # 1000 spans fail
+
+
+def test_peers_that_are_not_installed_are_said_skipped(tmp_path, monkeypatch):
+    from tumble.report_card import peers
+
+    monkeypatch.setattr(peers, "mujoco_available", lambda: False)
+    names = [row.name for row in report_card.rows(["rkmk4"])]
+    assert names == ["rkmk4", "scipy DOP853", "scipy RK45"]
+    # the card of one method, with the peers' note as report() makes it (their runs skipped)
+    card = report_card.report(quick=True, methods=["rkmk4"], peers=False, structural=False)
+    card = dataclasses.replace(card, skipped=report_card.skipped_peers(True))
+    report_card.write(card, tmp_path)
+    said = "MuJoCo RK4, MuJoCo Euler: not installed: rows skipped"
+    assert said in (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert said in (tmp_path / "report.html").read_text(encoding="utf-8")
+
+
 def test_growth_law_reads_bounded_drift_and_round_off():
     t = np.linspace(0.0, 1000.0, 2001)
     drift = 1.0 + 1e-6 * t

@@ -345,3 +345,215 @@ def test_batched_periods_equal_the_scenario_measure():
         assert found[k] == pytest.approx(expected, rel=1e-12)
     short = simulate_batch(body, 10.0, h=0.05, omega0=spins[:1])  # under one crossing pair
     assert np.isnan(periods(short.t, short.omega_body)).all()
+
+
+# ---------------------------------------------------------------------------------------
+# A built-in whose summary's keys depend on a swept option; sizes and places refused first.
+
+TOP = {"t_end": [0.05]}
+"""The spinning top over 50 steps: its summary's numbers, quickly."""
+
+
+def test_a_swept_option_that_changes_the_summarys_keys_stores_every_members_numbers(
+    client, tmp_path
+):
+    """The methods name the summary's keys (results.<method>.…): the store's variables are
+    every member's, and each member holds the numbers of its own run."""
+    from tumble.scenarios import spinning_top
+    from tumble.sweeps.members import summary_numbers
+
+    grid = {"tilt": [0.2, 0.3], "methods": [["yoshida4"], ["split-axes"]], **TOP}
+    ds = tumble.sweep("spinning-top", grid, client=client, store=tmp_path / "s.zarr")
+    for tilt in grid["tilt"]:
+        for methods in grid["methods"]:
+            where = {"tilt": tilt, "methods": json.dumps(methods), "t_end": 0.05}
+            member = ds.sel(where)
+            numbers = summary_numbers(spinning_top.run(tilt=tilt, methods=methods,
+                                                       t_end=0.05).summary)  # fmt: skip
+            for name, value in numbers.items():
+                if name in ds.data_vars:
+                    assert float(member[name]) == value or np.isnan(value), (where, name)
+            method = methods[0]
+            assert (
+                float(member[f"results.{method}.energy_drift"])
+                == numbers[f"results.{method}.energy_drift"]
+            )
+            other = {"yoshida4": "split-axes", "split-axes": "yoshida4"}[method]
+            assert np.isnan(float(member[f"results.{other}.energy_drift"]))  # not its method
+            assert int(member["done"]) == 1
+
+
+def test_a_member_with_numbers_the_store_does_not_name_writes_nothing():
+    """A task's member whose summary has keys no probe saw fails its task (no done flag)."""
+    import dataclasses
+
+    from tumble.sweeps.members import run_summaries
+
+    plan = make_plan("spinning-top", {"methods": [["yoshida4"]], **TOP})
+    partial = dataclasses.replace(plan, outputs=("mass",))
+    with pytest.raises(ValueError, match=r"member \(methods=\['yoshida4'\], t_end=0.05\) of "
+                       r"the sweep of 'spinning-top' has summary numbers the store has no "
+                       r"variable for: .*results\.yoshida4\.t_reached"):  # fmt: skip
+        run_summaries(partial, [(0, 0)])
+
+
+def test_probes_run_one_member_per_combination_of_the_values_that_are_not_real_numbers():
+    from tumble.sweeps.members import MAX_PROBES, probes
+
+    grid = {"tilt": [0.2, 0.3, 0.4], "methods": [["rkmk4"], ["yoshida4"], ["rkmk4"]],
+            "h": [0.001, 0.002]}  # fmt: skip
+    assert probes(make_plan("spinning-top", grid)) == [(0, 0, 0), (0, 1, 0)]
+    rows = {"tilt": [0.2, 0.3, 0.4], "methods": [["rkmk4"], ["yoshida4"], ["rkmk4"]]}
+    assert probes(make_plan("spinning-top", samples=rows)) == [(0,), (1,)]
+    many = {"methods": [[m] for m in ("rkmk4", "yoshida4", "strang")], "spin": [1, 2, 3]}
+    assert len(probes(make_plan("spinning-top", many))) == 9  # integers may shape, too
+    huge = {"spin": list(range(1, MAX_PROBES + 2))}
+    with pytest.raises(ValueError, match=rf"this sweep has {MAX_PROBES + 1}, more than "
+                       rf"{MAX_PROBES}; sweep fewer of them at a time"):  # fmt: skip
+        probes(make_plan("spinning-top", huge))
+
+
+def test_the_store_estimate_is_the_stores_uncompressed_size(client, tmp_path):
+    from tumble.sweeps.budget import estimate
+
+    grid = {"omega0.1": [18.0, 20.0, 22.0], "method": ["rkmk4", "lie-euler"]}
+    plan = make_plan(tiny(), grid, chunk=2)
+    ds = tumble.sweep(tiny(), grid, client=client, store=tmp_path / "s.zarr", chunk=2)
+    found = estimate(plan)
+    assert found.store == sum(ds[name].nbytes for name in ds.data_vars)
+    assert (found.members, found.tasks) == (6, 3)
+
+
+def test_a_store_larger_than_the_free_disk_is_refused_before_any_work(tmp_path):
+    """1e10 members: refused from the plan (no cluster, no store, no member run)."""
+    from tumble.sweeps.budget import free_space, size
+
+    axis = np.linspace(0.0, 1.0, 100_000)
+    with pytest.raises(ValueError) as refused:
+        tumble.sweep(tiny(), {"omega0.1": axis, "omega0.2": axis},
+                     client="tcp://127.0.0.1:1", store=tmp_path / "s.zarr")  # fmt: skip
+    message = str(refused.value)
+    per_member = 61 * 176 + 34  # 61 samples of the series, 33 B of summary, the flag
+    assert message.startswith(
+        f"the sweep's store would take up to {size(1e10 * per_member)}: 10000000000 members "
+        f"(100000 x 100000) of {size(per_member)} each, more than the "
+    )
+    assert f"free at {tmp_path}; sweep fewer members, store fewer samples" in message
+    assert free_space(tmp_path) < 1e10 * per_member
+    assert not (tmp_path / "s.zarr").exists()
+
+
+def test_a_client_too_large_for_memory_and_a_task_too_large_for_a_worker_are_refused():
+    from tumble.sweeps.budget import TASK_CLIENT_BYTES, check_fits, check_task
+
+    plan = make_plan(tiny(), {"omega0.1": np.linspace(0.0, 1.0, 1000)}, chunk=1)
+    with pytest.raises(ValueError, match=r"client would need about 1[89]\.\d MiB for 1000 "
+                       r"tasks of 1000 members \(1000\), more than the 5 MiB \(half of this "
+                       r"machine's memory\).*give larger tasks \(chunk, --chunk\)"):  # fmt: skip
+        check_fits(plan, ".", memory=10 * 2**20)
+    check_fits(plan, ".", memory=4 * 1000 * TASK_CLIENT_BYTES)  # room enough: no error
+    with pytest.raises(ValueError, match=r"a task of 1 members would hold about 31\.\d KiB "
+                       r".*one member alone is too large: store fewer samples"):  # fmt: skip
+        check_task(plan, 2**10)
+    wide = make_plan(tiny(), {"omega0.1": np.linspace(0.0, 1.0, 1000)}, chunk=500)
+    with pytest.raises(ValueError, match=r"give smaller tasks: chunk \(--chunk\) at most 9\b"):
+        check_task(wide, 2 * 9.5 * 3 * 10786)
+
+
+@pytest.mark.parametrize(
+    ("store", "message"),
+    [
+        (None, r"store=None is not allowed: must be a path \(str or pathlib.Path\)"),
+        ("", r"store='' is not allowed"),
+        ("/proc/x.zarr", r"store='/proc/x.zarr' is not allowed: must be a folder that can be "
+         r"created; /proc cannot hold it \(No such file or directory\)"),
+    ],
+)  # fmt: skip
+def test_a_store_that_cannot_be_written_is_refused_before_any_work(store, message):
+    with pytest.raises(ValueError, match=message):
+        tumble.sweep(tiny(), {"h": [0.01]}, client="tcp://127.0.0.1:1", store=store)
+    assert not Path("None").exists()
+
+
+@pytest.mark.parametrize(
+    ("option", "message"),
+    [
+        (["--map", "nosuch"], "--map='nosuch' is not allowed: must be one of 'status', "
+         "'n_steps', 'energy_error', 'flip_period', 'wall_time'"),
+        (["--map", "energy_error", "--grid", "h=0.01"], "--map='energy_error' is not "
+         "allowed: must be drawn over exactly two swept dimensions; this sweep has 1: "
+         "omega0.0"),
+        (["--out", "/proc/x.zarr"], "store='/proc/x.zarr' is not allowed: must be a folder "
+         "that can be created"),
+        (["--grid", "omega0.1=0:1:100000", "--grid", "omega0.2=0:1:100000"], "the sweep's "
+         "store would take up to"),
+    ],
+)  # fmt: skip
+def test_cli_refuses_what_cannot_work_before_any_member_runs(tmp_path, option, message):
+    """No cluster is reached (the scheduler address answers nothing): each is found first."""
+    from typer.testing import CliRunner
+
+    from tumble.cli import app
+
+    file = scenario_file(tmp_path)
+    out = ["--out", str(tmp_path / "s.zarr")] if "--out" not in option else []
+    grid = ["--grid", "omega0.0=0.1,0.2"] if option[-1] == "h=0.01" else []
+    args = ["sweep", str(file), *out, *grid, *option, "--scheduler", "tcp://127.0.0.1:1"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2, result.output
+    assert message in " ".join(result.output.split()), result.output
+    assert not (tmp_path / "s.zarr").exists()
+
+
+def test_cli_help_of_sweep_names_built_in_scenarios():
+    from typer.testing import CliRunner
+
+    from tumble.cli import app
+
+    result = CliRunner().invoke(app, ["sweep", "--help"], terminal_width=100)
+    assert "NAME|FILE.toml" in result.output
+    assert "built-in scenario's name" in " ".join(result.output.split())
+
+
+def test_cli_bar_counts_members_from_its_first_count(monkeypatch):
+    """The terminal shows what the sweep is doing, then n/N members: never 0/None."""
+    import io
+
+    from rich.console import Console
+
+    from tumble import cli
+
+    screen = io.StringIO()
+    monkeypatch.setattr(cli, "console", Console(file=screen, force_terminal=True, width=100))
+    with cli._members_bar() as progress:
+        progress(0, 4)
+        progress(4, 4)
+    assert "None" not in screen.getvalue()
+    assert "4/4 members" in screen.getvalue()
+
+
+@pytest.mark.parametrize(
+    ("dim", "path", "label"),
+    [
+        ("omega0.1", "initial.omega0.1", "ω_y (rad/s)"),
+        ("L0.2", "initial.L0.2", "L_z (kg m²/s)"),
+        ("spins.0.1", "spins.0.1", "ω_y of spins[0] (rad/s)"),
+        ("h", "h", "h (s)"),
+        ("method", "method", "method"),
+        ("body.density", "body.density", "body.density"),
+    ],
+)
+def test_sweep_maps_label_their_axes_with_a_short_name_and_unit(dim, path, label):
+    from tumble.sweeps.picture import axis_label
+
+    dataset = xr.Dataset(coords={dim: (dim, [1.0, 2.0], {"option_path": path})})
+    assert axis_label(dataset, dim) == label
+
+
+def test_the_gallery_card_of_the_flip_map_shows_its_picture():
+    """flip_map.py is not run by the gallery (a cluster): its thumbnail and its page show
+    docs/img/flip_map.png, the picture it draws."""
+    source = (EXAMPLES / "flip_map.py").read_text(encoding="utf-8")
+    assert '# sphinx_gallery_thumbnail_path = "img/flip_map.png"' in source
+    assert ".. image:: /img/flip_map.png" in source
+    assert (EXAMPLES.parent / "docs" / "img" / "flip_map.png").stat().st_size > 20_000

@@ -178,3 +178,38 @@ def test_output_larger_than_the_worker_memory_limit_completes(tmp_path):
         "trajectory"
     ]
     assert np.array_equal(ds["R"].isel({"omega0.2": -1}).values, trajectory.R)
+
+
+def test_ctrl_c_says_what_is_done_and_exits_130_without_a_traceback(tmp_path):
+    """SIGINT to the command's whole process group, as Ctrl-C at a terminal sends it (to the
+    client and the local cluster's workers): one line says how many members are done, exit
+    130, and nothing else on stderr (no worker's traceback, no Dask log line, no leaked
+    semaphore); the count is the store's."""
+    scenario = tmp_path / "box.toml"
+    scenario.write_text(
+        'scenario = "rigid-body"\n[options]\nh = 0.001\nt_end = 8.0\nrecord_every = 400\n'
+        '[options.body]\nshape = "box"\nextents = [0.3, 0.2, 0.1]\nmass = 2.0\n'
+        "[options.initial]\nomega0 = [0.1, 20.0, 0.1]\n"
+    )
+    store = tmp_path / "s.zarr"
+    args = [TUMBLE, "sweep", scenario, "--grid", "omega0.2=0:1:400", "--out", store,
+            "--chunk", "1"]  # fmt: skip
+    process = subprocess.Popen(
+        args, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+        # SIGINT as at a terminal even where the tests were started with it ignored
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),
+    )  # fmt: skip
+    try:
+        flags = store / "done"
+        wait_for(lambda: len(list(flags.glob("[0-9]*"))) >= 3, 120, "three members done")
+        os.killpg(process.pid, signal.SIGINT)
+        out, err = process.communicate(timeout=60)
+    finally:
+        kill(process)
+    done = int(xr.open_zarr(store)["done"].sum())
+    assert 3 <= done < 400
+    assert process.returncode == 130, err.decode()
+    assert err.decode().strip() == (
+        f"interrupted: {done} of 400 members done; complete with `--resume`"
+    )
+    assert "Traceback" not in out.decode()

@@ -36,22 +36,62 @@ def _bar(total: float, description: str) -> Iterator[Callable[..., None]]:
         yield lambda **done: bar.update(task, **done)
 
 
-log = logging.getLogger("tumble")
+log = logging.getLogger("tumble.compile")
+"""Where the word of a kernel compiling goes: at INFO, shown on stderr unless the program has
+handlers of its own (:class:`Notice`). ``logging.getLogger("tumble.compile").setLevel(
+logging.WARNING)`` silences it."""
+
+
+class Notice(logging.Handler):
+    """Writes a record to the current ``sys.stderr`` when no other handler would take it.
+
+    What :data:`logging.lastResort` does for warnings, for the compile notices: a script, a
+    REPL or a notebook (whose cells show ``sys.stderr``) sees one line, ``tumble: preparing
+    …``; a program that configured logging (a handler on ``tumble`` or the root, as the
+    command line's status line or pytest) gets the record through its own handlers only
+    (``tumble``'s own :class:`logging.NullHandler` does not count).
+    """
+
+    def emit(self, record: logging.LogRecord) -> None:
+        logger: logging.Logger | None = logging.getLogger(record.name)
+        while logger is not None:
+            if any(
+                handler is not self and not isinstance(handler, logging.NullHandler)
+                for handler in logger.handlers
+            ):
+                return
+            if not logger.propagate:
+                break
+            logger = logger.parent
+        import sys
+
+        try:
+            print(f"tumble: {record.getMessage()}", file=sys.stderr, flush=True)
+        except (OSError, ValueError):  # a closed stderr: nothing to tell
+            pass
+
+
+if not any(isinstance(handler, Notice) for handler in log.handlers):
+    log.addHandler(Notice())
+if log.level == logging.NOTSET:
+    log.setLevel(logging.INFO)
 
 
 def announce_compilation(kernel: Any, what: str) -> None:
-    """Log, at INFO, that ``kernel``'s first call in this process will compile it.
+    """Say, at INFO on ``tumble.compile``, that ``kernel``'s first call in this process will
+    compile it or load it from numba's cache.
 
-    A numba dispatcher with no signatures yet compiles on its first call: seconds the first
-    time after installation (1.8 s for ``simulate``'s loop, more for the batch loops), then a
-    fraction of a second to load it from numba's cache
-    (``cache=True``). The command line shows the message as its status line. The test is
-    the dispatcher's ``overloads`` dict, not ``signatures`` (which builds a list of types at
-    every call: 5.6 µs measured, a tenth of a short run).
+    A numba dispatcher with no signatures yet compiles on its first call: seconds to tens of
+    seconds the first time after installation (15 s measured for ``simulate_batch``'s loop
+    of ``rkmk4`` on a shared 2-core machine), then one to two seconds in a new process to
+    load it from numba's cache (``cache=True``). Shown on stderr by default (:class:`Notice`);
+    the command line shows it as its status line. The test is the dispatcher's ``overloads``
+    dict, not ``signatures`` (which builds a list of types at every call: 5.6 µs measured, a
+    tenth of a short run).
     """
     if not getattr(kernel, "overloads", True):
         log.info(
-            "preparing %s, compiled by numba (a few seconds the first time; later runs load it "
-            "from its cache)",
+            "preparing %s (numba: compiled on the first call after installation, 5-30 s; "
+            "loaded from its cache after, about 2 s)",
             what,
         )

@@ -27,6 +27,24 @@ from tumble import scenarios
 from tumble.io import write_run_folder
 from tumble.scenarios import ScenarioResult
 
+
+def _flags_take_no_value() -> None:
+    """Show no type after a flag in ``--help`` (typer 0.29 prints ``--quick <bool>``, as if a
+    flag took a value; ``--help`` itself too): options that are flags return no type."""
+    option = getattr(getattr(typer, "core", None), "TyperOption", None)
+    shown = getattr(option, "display_type_rich", None)
+    if shown is None or getattr(shown, "flags_take_no_value", False):
+        return
+
+    def display_type_rich(self: Any, ctx: Any) -> str | None:
+        return None if getattr(self, "is_flag", False) else shown(self, ctx)
+
+    display_type_rich.flags_take_no_value = True  # type: ignore[attr-defined]
+    option.display_type_rich = display_type_rich  # type: ignore[union-attr]
+
+
+_flags_take_no_value()
+
 app = typer.Typer(
     help="Simulate rigid bodies and vibrating structures; write run folders.",
     no_args_is_help=True,
@@ -184,7 +202,11 @@ def run(
     ] = True,
     force: Force = False,
     mp4: Annotated[
-        bool, typer.Option("--mp4", help="Also write animation.mp4 (H.264) beside the GIF.")
+        bool,
+        typer.Option(
+            "--mp4",
+            help="Also write animation.mp4 (H.264): beside the GIF, or alone with --no-animation.",
+        ),
     ] = False,
 ) -> None:
     """Run a scenario and write its run folder (data.nc, summary.json, pictures)."""
@@ -275,19 +297,18 @@ def stability(
         result = beam.stability(n_elements=n_elements, sweep_steps=steps)
         folder = _write(result, out or Path("runs") / "stability", force, False, note)
     summary = result.summary
+    # a row per scheme, a column per step: every scheme of SCHEMES in 80 columns
     table = Table(
-        title=f"critical Δt (semi-implicit) = {summary['critical_dt_semi_implicit']:.4g} s "
-        f"({summary['critical_mode']} mode)",
-        box=None,
-    )
-    table.add_column("Δt / Δt_crit", justify="right")
-    table.add_column("Δt [s]", justify="right")
-    for scheme in summary["schemes"]:
-        table.add_column(scheme)
-    verdicts = [summary["schemes"][s]["stable"] for s in summary["schemes"]]
-    for k, (factor, dt) in enumerate(zip(summary["factors"], summary["dt"], strict=True)):
-        cells = ["stable" if verdict[k] else "[red]grows[/]" for verdict in verdicts]
-        table.add_row(f"{factor:g}", f"{dt:.3g}", *cells)
+        title=f"Δt / Δt_crit, Δt_crit = {summary['critical_dt_semi_implicit']:.4g} s "
+        f"(semi-implicit, {summary['critical_mode']} mode)",
+        box=None, collapse_padding=True, pad_edge=False,
+    )  # fmt: skip
+    table.add_column("scheme")
+    for factor in summary["factors"]:
+        table.add_column(f"{factor:g}", justify="right")
+    for scheme, verdict in summary["schemes"].items():
+        cells = ["stable" if stable else "[red]grows[/]" for stable in verdict["stable"]]
+        table.add_row(scheme, *cells)
     console.print(table)
     console.print(f"plot: {folder / 'stability_sweep.png'}", highlight=False)
 
@@ -343,7 +364,14 @@ Grid = Annotated[
 
 @app.command()
 def sweep(
-    file: Annotated[Path, typer.Argument(help="A scenario file (.toml).")],
+    scenario: Annotated[
+        str,
+        typer.Argument(
+            metavar="NAME|FILE.toml",
+            help="A scenario file (.toml; rigid-body or a built-in's) or a built-in scenario's "
+            "name (tumble list; its summary's numbers are stored per member).",
+        ),
+    ],
     grid: Grid = None,
     out: Annotated[Path, typer.Option(help="The Zarr store to write (a folder).")] = Path(
         "runs/sweep.zarr"
@@ -352,7 +380,7 @@ def sweep(
         str | None, typer.Option(help="A Dask scheduler's address (default: a local cluster).")
     ] = None,
     resume: Annotated[
-        bool, typer.Option(help="Complete an existing store of this sweep.")
+        bool, typer.Option("--resume", help="Complete an existing store of this sweep.")
     ] = False,
     chunk: Annotated[int | None, typer.Option(help="Members per task.")] = None,
     timeout: Annotated[float, typer.Option(help="Seconds to wait for --scheduler.")] = 10.0,
@@ -361,42 +389,113 @@ def sweep(
         typer.Option(
             "--map",
             help="Draw this summary variable over the two swept dimensions: flip_period "
-            "(default), energy_error, wall_time, status, n_steps.",
+            "(default), energy_error, wall_time, status, n_steps; for a built-in, a number of "
+            "its summary.",
         ),
     ] = None,
+    verbose: Annotated[
+        bool, typer.Option("--verbose", help="Show Dask's own log lines (quiet by default).")
+    ] = False,
 ) -> None:
-    """Run a scenario over a grid of options on Dask, into one Zarr store."""
+    """Run a scenario over a grid of options on Dask, into one Zarr store (and draw a map)."""
+    from tumble.sweeps import Interrupted
     from tumble.sweeps import sweep as run_sweep
-    from tumble.sweeps.picture import draw_map, map_variable
+    from tumble.sweeps.picture import check_map
     from tumble.sweeps.text import grid_from_arguments
 
-    with _reported():
+    def on_plan(plan, estimate) -> None:
+        if draw:
+            check_map(plan, draw, "--map")
+        console.print(f"sweep: {estimate.text()}", highlight=False, soft_wrap=True)
+
+    with _reported(), _dask_quiet(verbose):
         values = grid_from_arguments(grid or [])
-        bar = Progress(TextColumn("sweep"), BarColumn(), TextColumn("{task.completed}/"
-                       "{task.total} members"), TimeElapsedColumn(), console=console,
-                       disable=not console.is_terminal)  # fmt: skip
-        with bar:
-            task = bar.add_task("members", total=None)
-            dataset = run_sweep(
-                str(file), values, client=scheduler, store=out, chunk=chunk,
-                resume=resume, timeout=timeout,
-                progress=lambda done, total: bar.update(task, completed=done, total=total),
-            )  # fmt: skip
-        done = dataset["done"].values
-        table = Table(title=f"sweep: {out}", box=None, show_header=False)
-        table.add_row("members", f"{done.size} ({' x '.join(map(str, done.shape))})")
-        if "status" in dataset:
-            status = dataset["status"].values
-            table.add_row("reached t_end", str(int((status == 0).sum())))
-            table.add_row("stopped (failed)", str(int((status < 0).sum())))
-        table.add_row("wall time of the members", f"{float(dataset['wall_time'].sum()):.3g} s")
-        console.print(table)
-        name, note = map_variable(dataset, draw)
-        if note:
-            console.print(note)
-        if name is not None:
-            picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
-            console.print(f"map: {picture}", highlight=False)
+        try:
+            with _members_bar() as progress:
+                run_sweep(
+                    scenario, values, client=scheduler, store=out, chunk=chunk, resume=resume,
+                    timeout=timeout, progress=progress, on_plan=on_plan,
+                )  # fmt: skip
+        except Interrupted as stopped:  # after the bar is gone
+            errors.print(str(stopped).replace("resume=True", "`--resume`"),
+                         markup=False, highlight=False, soft_wrap=True)  # fmt: skip
+            raise typer.Exit(code=130) from None
+        _show_sweep(out, draw)
+
+
+@contextmanager
+def _members_bar() -> Iterator[Callable[[int, int], None]]:
+    """The sweep's display: what it is doing (the library's status messages), then its bar
+    of members, counted from the first count on (never "0/None members")."""
+    bar = Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(),
+                   TextColumn("{task.fields[counts]}"), TimeElapsedColumn(), console=console,
+                   transient=True, disable=not console.is_terminal)  # fmt: skip
+    with bar:
+        task = bar.add_task("sweep: checking the plan", total=None, counts="")
+        started: list[bool] = []
+
+        def progress(done: int, total: int) -> None:
+            started.append(True)
+            bar.update(task, description="sweep", completed=done, total=total,
+                       counts=f"{done}/{total} members")  # fmt: skip
+
+        def note(stage: str) -> None:
+            if not started:  # then the bar says it all
+                bar.update(task, description=f"sweep: {stage.removeprefix('sweep: ')}")
+
+        with _status_from_log(note):
+            yield progress
+
+
+@contextmanager
+def _dask_quiet(verbose: bool) -> Iterator[None]:
+    """Dask's log lines off (a recovered worker is not an error to the user) unless
+    ``verbose``: in this process, and in the local workers it starts (they read the level
+    from the environment when they import distributed)."""
+    import os
+
+    if verbose:
+        yield
+        return
+    loggers = [logging.getLogger(name) for name in ("distributed", "tornado", "bokeh")]
+    levels = [logger.level for logger in loggers]
+    before = os.environ.get("DASK_LOGGING__DISTRIBUTED")
+    os.environ["DASK_LOGGING__DISTRIBUTED"] = "critical"
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels, strict=True):
+            logger.setLevel(level)
+        if before is None:
+            os.environ.pop("DASK_LOGGING__DISTRIBUTED", None)
+        else:
+            os.environ["DASK_LOGGING__DISTRIBUTED"] = before
+
+
+def _show_sweep(out: Path, draw: str | None) -> None:
+    """The sweep's table (members, how they ended, their time) and its map."""
+    import xarray as xr
+
+    from tumble.sweeps.picture import draw_map, map_variable
+
+    dataset = xr.open_zarr(out, chunks=None)  # numpy, not dask: one read per variable
+    done = dataset["done"].values
+    table = Table(title=f"sweep: {out}", box=None, show_header=False)
+    table.add_row("members", f"{done.size} ({' x '.join(map(str, done.shape))})")
+    if "status" in dataset:
+        status = dataset["status"].values
+        table.add_row("reached t_end", str(int((status == 0).sum())))
+        table.add_row("stopped (failed)", str(int((status < 0).sum())))
+    table.add_row("wall time of the members", f"{float(dataset['wall_time'].sum()):.3g} s")
+    console.print(table)
+    name, note = map_variable(dataset, draw)
+    if note:
+        console.print(note)
+    if name is not None:
+        picture = draw_map(dataset, name, out.with_name(f"{out.stem}-{name}.png"))
+        console.print(f"map: {picture}", highlight=False)
 
 
 @app.command()
@@ -468,7 +567,8 @@ def report_card(
     """The integrator report card: every method measured on the same problems, peers beside."""
     from tumble.report_card import report
 
-    with _reported():
+    # the bar names the compiling phase; the kernels' own notices would scroll past it
+    with _reported(), _status_from_log(lambda stage: None):
         card = report(out, quick=quick, progress=console.is_terminal)
     table = Table(title=f"report card: {len(card.results)} methods in {card.seconds:.0f} s",
                   box=None)  # fmt: skip
@@ -481,6 +581,11 @@ def report_card(
             "[red]contradicted[/]" if result.contradictions else "agrees",
         )  # fmt: skip
     console.print(table)
+    skipped: dict[str, list[str]] = {}
+    for peer, reason in card.skipped.items():
+        skipped.setdefault(reason, []).append(peer)
+    for reason, peers in skipped.items():
+        console.print(f"{', '.join(peers)}: {reason}", highlight=False)
     for name, why in card.contradictions.items():
         errors.print(f"contradiction: {name}:", style="bold red", end=" ")
         errors.print("; ".join(why), markup=False, highlight=False, soft_wrap=True)

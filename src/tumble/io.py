@@ -240,19 +240,28 @@ def write_run_folder(
     on_file : callable, optional
         Called with each file's name before it is written (for progress display).
     mp4 : bool
-        With ``animation``, write ``animation.mp4`` beside ``animation.gif`` (the same
-        writer: the format comes from the suffix; ffmpeg from ``imageio-ffmpeg``).
+        Write ``animation.mp4`` too: beside ``animation.gif``, or alone without
+        ``animation`` (the GIF's writer: the format comes from the suffix; ffmpeg from the
+        ``imageio-ffmpeg`` dependency).
 
     Returns
     -------
     Path
         The folder.
+
+    Raises
+    ------
+    ValueError
+        With ``mp4`` for a result that has no animation (before anything is written).
     """
+    given = list(result.animations)
+    movie = [("animation.mp4", w) for name, w in given if name == "animation.gif"] if mp4 else []
+    if mp4 and not movie:
+        raise _checks.fail("mp4", True, "given only for a result with an animation",
+                           remedy=f"{result.name!r} draws none; leave out --mp4")  # fmt: skip
     out = prepare_folder(out, force=force)
     _forget_previous_run(out)
-    animations = list(result.animations) if animation else []
-    if mp4:
-        animations += [("animation.mp4", w) for name, w in animations if name == "animation.gif"]
+    animations = (given if animation else []) + movie
     writers = list(result.figures) + animations
     files = []
     notify = on_file or (lambda name: None)

@@ -274,7 +274,8 @@ BAD_FILES = {
     ),
     "unknown load type": (
         RIGID + CYLINDER + '[[options.loads]]\ntype = "spring"\n',
-        "options.loads[0].type = 'spring': must be one of gravity, force, torque, impulse",
+        "options.loads[0].type = 'spring': must be one of gravity, force, torque, "
+        "magnetic-dipole, impulse",
     ),
     "load without type": (
         RIGID + CYLINDER + "[[options.loads]]\ng = [0.0, 0.0, -9.81]\n",
@@ -493,3 +494,12 @@ def test_declared_positive_options_refuse_zero(name):
         value = [0, 1] if "list" in str(model.model_fields[option].annotation) else 0
         with pytest.raises(ValueError, match=rf"options.{option} = .*must be > 0"):
             check_options(name, {option: value})
+
+
+def test_the_docs_table_of_loads_has_every_load_type():
+    from tumble.scenarios.loads import LOADS
+
+    page = (Path(__file__).parents[2] / "docs" / "scenario-files.md").read_text()
+    table = page.split("### `[[options.loads]]`")[1].split("###")[0]
+    listed = re.findall(r"^\| `([a-z-]+)` \|", table, flags=re.MULTILINE)
+    assert listed[1:] == list(LOADS)  # after the header's `type`

@@ -119,7 +119,8 @@ def test_gravity_drops_the_centre_of_mass_on_a_parabola():
     run = result.data["trajectory"]
     exact = np.outer(run.t, [1.0, 0.0, 2.0]) + np.outer(0.5 * run.t**2, [0.0, 0.0, -9.81])
     np.testing.assert_allclose(run.x, exact, rtol=0, atol=1e-12)  # RK4 is exact on quadratics
-    assert result.summary["conserved"] == {"energy": False, "angular_momentum": True}
+    # T + V is kept (gravity has a potential), L too (no torque about the centre of mass)
+    assert result.summary["conserved"] == {"energy": True, "angular_momentum": True}
     assert result.summary["momentum_drift"] < 1e-14  # no torque: L += h·0 is exact (0)
 
 
@@ -245,3 +246,37 @@ def test_prepared_start_puts_the_body_where_its_description_does():
 def test_runs_batch_with_a_fixed_step_under_constant_loads(changes, batchable):
     options = rigid_body.OPTIONS.model_validate({"body": BOX, **changes})
     assert rigid_body.prepare(options).batchable is batchable
+
+
+def test_every_load_class_of_the_library_is_a_load_type_of_the_files():
+    """A new load class in tumble.rigid.forces needs its row in scenarios.loads.LOADS."""
+    import typing
+
+    from tumble.rigid import forces
+    from tumble.scenarios.loads import LOADS
+
+    classes = {*typing.get_args(forces.Load), forces.Impulse}
+    assert classes == {row.load for row in LOADS.values()}
+
+
+def test_a_magnetic_dipole_in_a_file_is_the_library_load():
+    """A compass needle: the file's load is MagneticDipole(moment, field), bit for bit, and
+    it keeps T + V but turns L."""
+    from tumble.rigid import MagneticDipole, simulate
+
+    needle = {"type": "magnetic-dipole", "moment": [0.2, 0.0, 0.0], "field": [0.0, 1e-3, 0.0]}
+    initial = {"omega0": [0.0, 0.0, 0.5]}
+    result = rigid_body.run(body=BOX, initial=initial, loads=[needle], t_end=1.0, h=0.01)
+    trajectory = result.data["trajectory"]
+    alone = simulate(trajectory.body, 1.0, h=0.01, omega0=[0.0, 0.0, 0.5],
+                     forces=[MagneticDipole((0.2, 0.0, 0.0), (0.0, 1e-3, 0.0))])  # fmt: skip
+    assert np.array_equal(trajectory.R, alone.R)
+    assert np.array_equal(trajectory.potential_energy, alone.potential_energy)
+    assert result.summary["conserved"] == {"energy": True, "angular_momentum": False}
+
+
+def test_a_load_key_the_type_does_not_take_is_named_with_the_allowed_ones():
+    needle = {"type": "magnetic-dipole", "moment": [0.2, 0.0, 0.0], "feild": [0.0, 1.0, 0.0]}
+    with pytest.raises(ValueError, match=r"loads\[0\]\.feild is not a key of a "
+                       r"magnetic-dipole load; allowed: field, moment, type"):  # fmt: skip
+        rigid_body.run(body=BOX, loads=[needle])

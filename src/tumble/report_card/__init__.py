@@ -75,7 +75,15 @@ from tumble.report_card.measure import (
     invariants,
     study_row,
 )
-from tumble.report_card.peers import CLAIMS, Row, Sampled, method_row, rows, run_row
+from tumble.report_card.peers import (
+    CLAIMS,
+    Row,
+    Sampled,
+    method_row,
+    rows,
+    run_row,
+    skipped_peers,
+)
 from tumble.report_card.problems import (
     PROBLEM_T,
     SWEEP_T,
@@ -129,6 +137,7 @@ __all__ = [
     "report",
     "rows",
     "run_row",
+    "skipped_peers",
     "structural_rows",
     "study_row",
     "warm_cost",
@@ -183,13 +192,18 @@ def report(
     long_t = 1000.0 if quick else 10000.0
     repeat = 1 if quick else 3
     tests = problems()
-    references = {problem.name: reference(problem) for problem in tests}
     tumble_names = [row.name for row in chosen if row.source == "tumble"]
     results = []
     timings = [tumble_names] if quick else [[name] for name in tumble_names]
-    with progress_bar(progress, len(timings) + len(chosen) + 1, "report card") as update:
+    steps = 1 + len(timings) + len(chosen) + 1
+    with progress_bar(progress, steps, "report card: the reference solutions") as update:
+        references = {problem.name: reference(problem) for problem in tests}
+        update(advance=1)
         first, note = {}, ""
-        for names in timings:
+        for k, names in enumerate(timings, start=1):
+            what = f"{k} of {len(timings)}" if len(timings) > 1 else "all methods"
+            update(description=f"report card: first calls in a fresh process, compiling "
+                   f"({what})")  # fmt: skip
             times, note = first_call_times(names, separate=not quick)
             first.update(times)
             update(advance=1)
@@ -202,7 +216,7 @@ def report(
         update(advance=1)
     card = ReportCard(results, structural_table, setup, machine(), quick, long_t,
                       time.perf_counter() - started, note,
-                      [problem.name for problem in tests])  # fmt: skip
+                      [problem.name for problem in tests], skipped_peers(peers))  # fmt: skip
     if out is not None:
         write(card, out)
     return card

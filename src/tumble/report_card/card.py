@@ -7,13 +7,13 @@ import math
 import os
 import platform
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from tumble._version import __version__
-from tumble.report_card.cost import warm_cost
+from tumble.report_card.cost import fixed_cost, warm_cost
 from tumble.report_card.measure import (
     Invariants,
     Order,
@@ -45,6 +45,7 @@ class RowResult:
     cost_us: float
     first_call_s: float
     contradictions: list[str]
+    fixed_us: float = math.nan  # the fixed cost of one call, µs (a run of one step)
 
 
 @dataclass
@@ -60,6 +61,7 @@ class ReportCard:
     seconds: float
     first_call_note: str
     problems: list[str]
+    skipped: dict[str, str] = field(default_factory=dict)  # peer rows left out, and why
 
     @property
     def contradictions(self) -> dict[str, list[str]]:
@@ -78,9 +80,10 @@ def measure_row(row: Row, tests: list[CardProblem], references: dict[str, np.nda
     its sweeps, order, errors at T, long-run invariants, cost and contradictions."""
     log.info("report card: measuring %s", row.name)
     p1, forced = tests[0], tests[-1]
-    free_sweep = study_row(row, p1, references[p1.name], repeat)
+    fixed = fixed_cost(row, p1)
+    free_sweep = study_row(row, p1, references[p1.name], repeat, fixed)
     assert free_sweep is not None
-    forced_sweep = study_row(row, forced, references[forced.name], repeat)
+    forced_sweep = study_row(row, forced, references[forced.name], repeat, fixed)
     sweeps = {data.problem: data for data in (free_sweep, forced_sweep) if data is not None}
     if row.adaptive:  # the order of the formula it propagates, at fixed steps
         order = adaptive_order(row, free_sweep, references[p1.name], p1)
@@ -94,7 +97,7 @@ def measure_row(row: Row, tests: list[CardProblem], references: dict[str, np.nda
     cost = warm_cost(row, p1, repeat)
     found = contradictions(row, order, free_inv, forced_inv)
     return RowResult(row, order, sweeps, errors, free_inv, forced_inv, cost,
-                     float(first.get(row.name, math.nan)), found)  # fmt: skip
+                     float(first.get(row.name, math.nan)), found, fixed * 1e6)  # fmt: skip
 
 
 def machine() -> dict:

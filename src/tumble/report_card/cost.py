@@ -13,7 +13,7 @@ import time
 from collections.abc import Sequence
 
 from tumble import exact
-from tumble.report_card.measure import sampled, standard_setting
+from tumble.report_card.measure import STANDARD_H, sampled, standard_setting
 from tumble.report_card.peers import Row, run_row
 from tumble.report_card.problems import P1_L0, CardProblem, p1_body
 from tumble.rigid import METHODS, simulate
@@ -74,6 +74,20 @@ def _fresh_process(names: Sequence[str], cache: str | None) -> dict[str, float]:
         log.warning("timing the first calls failed: %s", done.stderr.strip()[-500:])
         return dict.fromkeys(names, math.nan)
     return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+FIXED_TRIALS = 5
+"""The fixed cost of a call is the best of this many one-step calls."""
+
+
+def fixed_cost(row: Row, problem: CardProblem) -> float:
+    """The fixed cost of one call, s: the best of :data:`FIXED_TRIALS` runs of one step of
+    :data:`~tumble.report_card.measure.STANDARD_H` (a few steps for an adaptive row), after a
+    warm-up: what a run costs before its steps (checks, set-up, the record)."""
+    setting = standard_setting(row)
+    run_row(row, problem, setting, t_end=STANDARD_H)
+    return min(sampled(row, problem, setting, t_end=STANDARD_H).seconds
+               for _ in range(FIXED_TRIALS))  # fmt: skip
 
 
 def warm_cost(row: Row, problem: CardProblem, repeat: int) -> float:

@@ -64,6 +64,18 @@ def mujoco_available() -> bool:
     return True
 
 
+MUJOCO_ROWS = ("MuJoCo RK4", "MuJoCo Euler")
+"""The peer rows MuJoCo gives when it is installed."""
+
+
+def skipped_peers(peers: bool = True) -> dict[str, str]:
+    """The peer rows :func:`rows` leaves out, each with why (MuJoCo not installed)."""
+    if not peers or mujoco_available():
+        return {}
+    why = "not installed: rows skipped (MuJoCo is in the bench extra: pip install -e '.[bench]')"
+    return dict.fromkeys(MUJOCO_ROWS, why)
+
+
 def rows(methods: Iterable[str] | None = None, *, peers: bool = True) -> list[Row]:
     """Every method of :data:`tumble.rigid.METHODS` (or those named), then the peers."""
     names = list(METHODS) if methods is None else list(methods)

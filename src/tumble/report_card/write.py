@@ -14,11 +14,13 @@ from tumble import _checks
 from tumble._atomic import atomic_write
 from tumble.report_card.card import ReportCard, RowResult
 from tumble.report_card.measure import (
+    AMORTISE,
     ASYMPTOTIC,
     BOUNDED_SLOPE,
     FIT_POINTS,
     LONG_H,
     LONG_RTOL,
+    MAX_SPANS,
     ORDER_TOLERANCE,
     ROUND_OFF,
     STANDARD_H,
@@ -43,7 +45,9 @@ def write(card: ReportCard, out: str | os.PathLike[str]) -> Path:
                            remedy=str(error.strerror or error)) from None  # fmt: skip
     text = markdown(card)
     atomic_write(folder / "report.md", lambda tmp: tmp.write_text(text, encoding="utf-8"))
-    write_html(folder / "report.html", plot_data(card), title=card.title)
+    below = text.split("\n", 1)[1]  # the page has the title already
+    write_html(folder / "report.html", plot_data(card), title=card.title, tables=below,
+               notes=_peer_notes(card))  # fmt: skip
     write_dataset(folder / "report.nc", datasets(card), {"title": card.title, **card.machine})
     return folder
 
@@ -59,6 +63,7 @@ def plot_data(card: ReportCard) -> list[dict]:
                 "setting": "rtol" if result.row.adaptive else "h",
                 "flagged": bool(result.contradictions),
                 "why": result.contradictions,
+                "fixed": result.fixed_us * 1e-6,
                 "sweeps": {
                     name: {
                         "seconds": data.seconds,
@@ -126,6 +131,8 @@ def _per_row(card: ReportCard):
             "orthogonality_max": ("method", column(lambda r: r.free.orthogonality_max)),
             "quaternion_max": ("method", column(lambda r: r.free.quaternion_max)),
             "cost_us_per_step": ("method", column(lambda r: r.cost_us), {"units": "µs"}),
+            "fixed_cost_us": ("method", column(lambda r: r.fixed_us), {"units": "µs",
+                              "long_name": "the fixed cost of one call (a run of one step)"}),
             "first_call_s": ("method", column(lambda r: r.first_call_s), {"units": "s"}),
             "contradictions": ("method", ["; ".join(r.contradictions) for r in card.results]),
             "claims": ("method", [", ".join(sorted(r.row.claims)) for r in card.results]),
@@ -201,8 +208,8 @@ def _sci(value: float) -> str:
 
 def markdown(card: ReportCard) -> str:
     """The report as markdown: the contradictions first, then the tables."""
-    sections = [_heading, _contradictions, _orders, _errors, _invariants, _costs, _schemes,
-                _closing]  # fmt: skip
+    sections = [_heading, _contradictions, _orders, _errors, _twins, _invariants, _costs,
+                _schemes, _closing]  # fmt: skip
     return "\n".join(line for section in sections for line in section(card))
 
 
@@ -218,6 +225,41 @@ def _heading(card: ReportCard) -> list[str]:
         f"numpy {m['numpy']}, scipy {m['scipy']}, numba {m['numba']}, tumble {m['tumble']}; "
         f"{m['date']}; the report took {card.seconds:.0f} s. Other work shared the machine, "
         "so the times are indicative.",
+        "",
+        *[f"{note}." for note in _peer_notes(card)],
+        *([""] if card.skipped else []),
+    ]
+
+
+def _peer_notes(card: ReportCard) -> list[str]:
+    """One sentence per skipped peer group: ``MuJoCo RK4, MuJoCo Euler: not installed: …``."""
+    groups: dict[str, list[str]] = {}
+    for name, why in card.skipped.items():
+        groups.setdefault(why, []).append(name)
+    return [f"{', '.join(names)}: {why}" for why, names in groups.items()]
+
+
+TWINS = ("euler-quat", "lie-euler")
+"""Two first-order methods whose errors agree to about two digits, for a reason (below)."""
+
+
+def _twins(card: ReportCard) -> list[str]:
+    """Why ``euler-quat`` and ``lie-euler`` show the same errors, with the measured gap."""
+    found = {r.row.name: r for r in card.results if r.row.name in TWINS}
+    if len(found) < 2:
+        return []
+    a, b = (found[name].errors for name in TWINS)
+    gaps = [abs(a[p] / b[p] - 1) for p in card.problems
+            if math.isfinite(a[p]) and math.isfinite(b[p]) and b[p] > 0]  # fmt: skip
+    gap = f"{max(gaps):.1%}" if gaps else "—"
+    return [
+        f"Why `euler-quat` and `lie-euler` show the same errors above (largest relative "
+        f"difference {gap} over the problems): both turn the body, over a step, about the "
+        "axis of the angular velocity ω at its start, the one first-order error they share; "
+        "`lie-euler` by the angle h|ω| (R exp(hω̂)), `euler-quat` by 2 arctan(h|ω|/2) = "
+        "h|ω| − (h|ω|)³/12 + … (the normalised q + (h/2) q ⊗ ω). Their steps differ by "
+        "O(h³), below the O(h²) error each step makes, so their errors agree to relative "
+        "O(h²), and in two digits.",
         "",
     ]
 
@@ -333,13 +375,19 @@ def _costs(card: ReportCard) -> list[str]:
         f"{STANDARD_RTOL:g}; best of {1 if card.quick else 3}); {card.first_call_note}. "
         "tumble's methods run compiled wherever their loads allow (as `simulate` chooses), "
         "scipy in Python, MuJoCo in C called step by step from Python. An adaptive method's "
-        "cost per step includes `simulate`'s per-call work spread over few steps.",
+        "cost per step includes `simulate`'s per-call work spread over few steps. The fixed "
+        "cost of a call is what a run of one step takes (best of 5): every run pays it "
+        f"once, whatever its length. In the work–precision figures of `report.html`, a run "
+        f"shorter than {AMORTISE} times it is timed over up to {MAX_SPANS} spans of T in "
+        "one call, so that the points show what the steps cost; the fixed cost is drawn "
+        "there as a line of its own.",
         "",
-        "| method | µs/step | first call (s) |",
-        "| --- | ---: | ---: |",
+        "| method | µs/step | fixed µs/call | first call (s) |",
+        "| --- | ---: | ---: | ---: |",
     ]
     for r in card.results:
-        lines.append(f"| {r.row.name} | {_number(r.cost_us, 3)} | {_number(r.first_call_s)} |")
+        lines.append(f"| {r.row.name} | {_number(r.cost_us, 3)} | {_number(r.fixed_us, 3)} | "
+                     f"{_number(r.first_call_s)} |")  # fmt: skip
     return [*lines, ""]
 
 
@@ -374,7 +422,8 @@ def _schemes(card: ReportCard) -> list[str]:
 def _closing(card: ReportCard) -> list[str]:
     return [
         "The interactive work–precision diagrams (orientation and energy error against wall "
-        "time, the Pareto front marked) are in `report.html`, the raw numbers in `report.nc`, "
+        "time, the Pareto front marked) are in `report.html`, above these tables, the raw "
+        "numbers in `report.nc`, "
         "both written beside `report.md` by `tumble report` (`make report` keeps them in "
         "`runs/report/` and copies this page to `docs/report.md`).",
         "",

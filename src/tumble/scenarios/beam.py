@@ -264,10 +264,13 @@ def stability(
     *,
     n_elements: int = 20,
     sweep_steps: int = 1000,
-    schemes: tuple[str, ...] = structural.SEED_SCHEMES,
+    schemes: tuple[str, ...] = tuple(structural.SCHEMES),
     factors: tuple[float, ...] = SWEEP_FACTORS,
 ) -> ScenarioResult:
     """The cantilever's Δt sweep on its own (``tumble stability``): which schemes stay bounded.
+
+    By default every scheme of :data:`tumble.structural.SCHEMES` (the seed's four, Newmark,
+    HHT, generalized-α, Bathe, Wilson-θ).
 
     Each scheme runs ``sweep_steps`` steps from rest under the tip load at
     ``Δt = factor × 2/ω_max`` for each factor (:func:`tumble.structural.stability_sweep`);

@@ -17,10 +17,11 @@ The simulated body has its centre of mass ``com`` at the origin and keeps the ax
 description (its inertia need not be diagonal). At ``t = 0`` the body stands where the
 description puts it: ``x0`` defaults to ``com`` and the attitude to the identity.
 
-Loads are constant: ``gravity`` (``g`` in m/s²); ``force`` (``force`` in N, world frame, at
-a ``point`` fixed on the body, in the description's coordinates; default the centre of
-mass); ``torque`` (N m, world frame); ``impulse`` (``impulse`` in N s at the world
-``point`` at ``time``).
+Loads are constant, one row each of :data:`tumble.scenarios.loads.LOADS`: ``gravity`` (``g``
+in m/s²); ``force`` (``force`` in N, world frame, at a ``point`` fixed on the body, in the
+description's coordinates; default the centre of mass); ``torque`` (N m, world frame);
+``magnetic-dipole`` (``moment`` in A m², body axes, in a uniform ``field`` in T, world axes);
+``impulse`` (``impulse`` in N s at the world ``point`` at ``time``).
 
 The body models are in :mod:`tumble.scenarios.bodies`; this module holds the rest of
 :data:`OPTIONS` (initial state, loads, method), :func:`prepare` (the body, its loads, its
@@ -32,7 +33,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import partial
-from typing import Annotated, Any, ClassVar, Literal
+from typing import TYPE_CHECKING, Annotated, Any, ClassVar, Union
 
 import numpy as np
 from pydantic import AfterValidator, Field, model_validator
@@ -42,11 +43,8 @@ from tumble.io import ScenarioResult
 from tumble.mass import MassProperties
 from tumble.rigid import (
     BatchTrajectory,
-    Force,
-    Gravity,
     Impulse,
     RigidBody,
-    Torque,
     Trajectory,
     simulate,
     simulate_batch,
@@ -56,6 +54,7 @@ from tumble.rigid.methods import METHODS, get_method
 from tumble.scenarios._base import rigid_attrs, rigid_outputs
 from tumble.scenarios._common import json_number
 from tumble.scenarios.bodies import Body
+from tumble.scenarios.loads import SECTIONS, LoadSection, torque_free
 from tumble.scenarios.schema import (
     Matrix3,
     NonNegative,
@@ -112,54 +111,11 @@ class Initial(Section):
         return initial_attitude(self.R0, self.q0)
 
 
-class GravityLoad(Section):
-    """Uniform gravity ``g`` (m/s², world)."""
-
-    what: ClassVar[str] = "a key of a gravity load"
-    type: Literal["gravity"]
-    g: Vector3 = [0.0, 0.0, -9.81]
-
-    def build(self, com: np.ndarray) -> Gravity:
-        return Gravity(self.g)
-
-
-class ForceLoad(Section):
-    """A constant world force (N) at a body point (the description's coordinates, m)."""
-
-    what: ClassVar[str] = "a key of a force load"
-    type: Literal["force"]
-    force: Vector3
-    point: Vector3 | None = None
-
-    def build(self, com: np.ndarray) -> Force:
-        return Force(self.force, None if self.point is None else np.subtract(self.point, com))
-
-
-class TorqueLoad(Section):
-    """A constant world torque (N m) about the centre of mass."""
-
-    what: ClassVar[str] = "a key of a torque load"
-    type: Literal["torque"]
-    torque: Vector3
-
-    def build(self, com: np.ndarray) -> Torque:
-        return Torque(self.torque)
-
-
-class ImpulseLoad(Section):
-    """A kick ``impulse`` (N s, world) at the world ``point`` (m) at ``time`` (s)."""
-
-    what: ClassVar[str] = "a key of an impulse load"
-    type: Literal["impulse"]
-    impulse: Vector3
-    point: Vector3
-    time: NonNegative = 0.0
-
-    def build(self, com: np.ndarray) -> Impulse:
-        return Impulse(point=self.point, impulse=self.impulse, time=self.time)
-
-
-Load = Annotated[GravityLoad | ForceLoad | TorqueLoad | ImpulseLoad, Field(discriminator="type")]
+if TYPE_CHECKING:
+    Load = LoadSection
+else:  # one of the sections, told apart by their type
+    Load = Annotated[Union[tuple(SECTIONS.values())], Field(discriminator="type")]  # noqa: UP007
+"""A load table of the file: one of :data:`tumble.scenarios.loads.SECTIONS`, by ``type``."""
 
 
 class Options(Section):
@@ -180,13 +136,14 @@ class Options(Section):
     def _consistent(self) -> Options:
         check_table(lambda: check_steps(get_method(self.method), self.h, self.rtol, self.atol))
         for index, load in enumerate(self.loads):
-            if isinstance(load, ImpulseLoad) and load.time > self.t_end:
+            time = getattr(load, "time", 0.0)  # a kick's, the only load at one instant
+            if time > self.t_end:
                 raise custom_error(
                     "whole_late",
                     "loads[{index}].time = {time} is after t_end = {t_end}; the impulse "
                     "would never act",
                     index=index,
-                    time=load.time,
+                    time=time,
                     t_end=self.t_end,
                 )
         return self
@@ -308,7 +265,8 @@ def run(
         (``[w, x, y, z]``) or ``euler_zyx`` (``[φ_z, θ_y, ψ_x]``, rad), one of ``omega0``
         (rad/s, body frame) or ``L0`` (kg m²/s, world frame).
     loads : list of dict
-        Each with ``type`` ``"gravity"``, ``"force"``, ``"torque"`` or ``"impulse"``.
+        Each with a ``type`` of :data:`tumble.scenarios.loads.LOADS` (``"gravity"``,
+        ``"force"``, ``"torque"``, ``"magnetic-dipole"``, ``"impulse"``) and its keys.
     method : str
         A :data:`tumble.rigid.METHODS` name.
     h : float or None
@@ -393,17 +351,15 @@ def _setting(options: Options) -> str:
 
 
 def _conserved(forces: list) -> dict[str, bool]:
-    """Whether energy and angular momentum stay constant under ``forces`` after ``t = 0``."""
+    """Whether energy and angular momentum stay constant under ``forces`` after ``t = 0``:
+    the energy ``T + V`` when every continuous load has a potential, the angular momentum
+    when none exerts a torque (:data:`tumble.scenarios.loads.LOADS`); a kick after the
+    start changes both."""
     late_kick = any(isinstance(load, Impulse) and load.time > 0 for load in forces)
     continuous = [load for load in forces if not isinstance(load, Impulse)]
-    turning = [
-        load
-        for load in continuous
-        if isinstance(load, Torque) or (isinstance(load, Force) and load.point is not None)
-    ]
     return {
-        "energy": not (continuous or late_kick),
-        "angular_momentum": not (turning or late_kick),
+        "energy": all(load.conservative for load in continuous) and not late_kick,
+        "angular_momentum": all(map(torque_free, continuous)) and not late_kick,
     }
 
 

@@ -18,7 +18,9 @@ spends its time in the compiled loop.
 from __future__ import annotations
 
 import copy
+import itertools
 import json
+import math
 import time as clock
 from typing import Any
 
@@ -62,19 +64,125 @@ def summary_numbers(summary: Any, key: str = "") -> dict[str, float]:
     return {}
 
 
+MAX_PROBES = 64
+"""At most this many first runs name a built-in sweep's stored numbers (:func:`probes`)."""
+
+
+def shaping_columns(plan: Plan) -> list[int]:
+    """The swept columns whose values may change which numbers a built-in's summary has.
+
+    A column of real numbers (with at least one float) moves the numbers, not their names;
+    any other (names, lists such as ``methods``, booleans, integers such as a count of
+    elements) may add or remove entries of the summary (``results.split-axes.…``).
+    """
+    shaping = []
+    for k, column in enumerate(plan.values):
+        numbers = all(isinstance(v, int | float) and not isinstance(v, bool) for v in column)
+        if not (numbers and any(isinstance(v, float) for v in column)):
+            shaping.append(k)
+    return shaping
+
+
+def probes(plan: Plan) -> list[tuple[int, ...]]:
+    """One member for each combination of the :func:`shaping_columns`' values.
+
+    For a grid, the product of each shaping dimension's distinct values (the first index of
+    each), every other dimension at its first value; for samples, the first row of each
+    distinct combination. Their summaries together have every number of every member.
+
+    Raises
+    ------
+    ValueError
+        When there are more than :data:`MAX_PROBES` combinations.
+    """
+    shaping = shaping_columns(plan)
+    if plan.samples:
+        firsts: dict[str, int] = {}
+        for row in range(plan.size):
+            key = json.dumps([plan.values[k][row] for k in shaping], sort_keys=True)
+            firsts.setdefault(key, row)
+        count = len(firsts)
+    else:
+        axes = [_first_of_each(column) if k in shaping else [0]
+                for k, column in enumerate(plan.values)]  # fmt: skip
+        count = math.prod(map(len, axes))
+    if count > MAX_PROBES:
+        names = ", ".join(plan.names[k] for k in shaping)
+        raise ValueError(
+            f"a sweep of scenario {plan.scenario!r} stores the numbers its summary has, named "
+            f"by a first run of each combination of the swept values that are not real "
+            f"numbers ({names}): this sweep has {count}, more than {MAX_PROBES}; sweep fewer "
+            "of them at a time (one store each)"
+        )
+    if plan.samples:
+        return [(row,) for row in firsts.values()]
+    return list(itertools.product(*axes))
+
+
+def _first_of_each(column: list) -> list[int]:
+    """The index of the first occurrence of each distinct value of ``column``."""
+    seen: dict[str, int] = {}
+    for index, value in enumerate(column):
+        seen.setdefault(json.dumps(value, sort_keys=True), index)
+    return list(seen.values())
+
+
+def member_options(plan: Plan, index: tuple[int, ...]) -> dict:
+    """A built-in member's options: the plan's, with each swept path set to its value."""
+    options = copy.deepcopy(plan.options)
+    for k, (path, values) in enumerate(zip(plan.paths, plan.values, strict=True)):
+        set_path(options, path, values[index[0] if plan.samples else index[k]])
+    return options
+
+
+def summary_names(plan: Plan, index: tuple[int, ...]) -> list[str]:
+    """The numbers of member ``index``'s summary (a built-in's), by dotted key."""
+    from tumble.scenarios import registry
+    from tumble.scenarios.files import check_options
+
+    options = check_options(plan.scenario, member_options(plan, index))
+    return list(summary_numbers(registry.get(plan.scenario).run(**options).summary))
+
+
+def echoes(plan: Plan) -> set[str]:
+    """Summary keys a sweep does not store: the swept options' echo and its own variables."""
+    return {*plan.dims, *plan.names, "member", "done", WALL_TIME}
+
+
 def run_summaries(plan: Plan, indices: list[tuple[int, ...]]) -> dict[str, np.ndarray]:
-    """A built-in scenario's members, one ``run`` each: their summaries' numbers and times."""
+    """A built-in scenario's members, one ``run`` each: their summaries' numbers and times.
+
+    Raises
+    ------
+    ValueError
+        If a member's summary has a number the store has no variable for (its task then
+        writes nothing and marks nothing done): the store's variables were named by the
+        first runs of :func:`probes`, so a real-valued option changed the summary's keys.
+    """
     from tumble.scenarios import registry
     from tumble.scenarios.files import check_options
 
     out = {name: np.full(len(indices), np.nan) for name in (*plan.outputs, WALL_TIME)}
+    skipped = echoes(plan)
     for m, index in enumerate(indices):
         start = clock.perf_counter()
-        options = copy.deepcopy(plan.options)
-        for k, (path, values) in enumerate(zip(plan.paths, plan.values, strict=True)):
-            set_path(options, path, values[index[0] if plan.samples else index[k]])
+        options = member_options(plan, index)
         result = registry.get(plan.scenario).run(**check_options(plan.scenario, options))
-        for name, value in summary_numbers(result.summary).items():
+        numbers = summary_numbers(result.summary)
+        unnamed = [name for name in numbers if name not in out and name not in skipped]
+        if unnamed:
+            where = ", ".join(
+                f"{name}={plan.values[k][index[0] if plan.samples else index[k]]!r}"
+                for k, name in enumerate(plan.names)
+            )
+            raise ValueError(
+                f"member ({where}) of the sweep of {plan.scenario!r} has summary numbers the "
+                f"store has no variable for: {', '.join(unnamed[:5])}; its numbers were not "
+                "written. The store's variables come from a first run of each combination "
+                "of the swept values that are not real numbers: sweep this option in "
+                "separate sweeps"
+            )
+        for name, value in numbers.items():
             if name in out:
                 out[name][m] = value
         out[WALL_TIME][m] = clock.perf_counter() - start

