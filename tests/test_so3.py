@@ -160,7 +160,8 @@ def test_quat_normalize_refuses_zero_norm_naming_the_argument():
 
 def test_quat_normalize_refuses_wrong_shape():
     with pytest.raises(
-        ValueError, match=r"q=.* is not allowed: must be of shape \(\.\.\., 4\).*\(3,\)"
+        ValueError,
+        match=r"q=.* must be quaternions \[w, x, y, z\] of shape \(\.\.\., 4\).*\(3,\)",
     ):
         so3.quat_normalize([1.0, 0.0, 0.0])
 

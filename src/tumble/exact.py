@@ -8,6 +8,11 @@ best of N, error against the reference), and fits through one policy, :func:`fit
 Conventions (SPEC §2): SI units; R maps body to world; ω_body = Rᵀ ω_world; inertia about the
 centre of mass in body axes; Euler's equations I ω̇ = (I ω) × ω; L = R I ω_body is constant.
 
+Bad input is refused by name. A spin so large that its angle or energy overflows (past about
+1e154 rad/s) is not bad input but beyond doubles: :func:`sphere`, :func:`free_body` and
+:func:`free_body_rotation` give NaN there (no warning), so that a run compared with them
+reports its own failure; :class:`Projectile` refuses a time at which its position overflows.
+
 References
 ----------
 .. [1] L. D. Landau, E. M. Lifshitz, Mechanics, 3rd ed., Pergamon 1976, §33, §35, §37.
@@ -19,14 +24,15 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Generic, SupportsFloat, TypeVar
+from typing import Any, Generic, SupportsFloat, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from tumble import _checks
+from tumble import _checks, so3
 from tumble._elliptic import (
     body_omega,
     body_period,
@@ -73,6 +79,16 @@ class Projectile:
         _checks.positive("g", self.g, "m/s²")
         _checks.finite("x0", self.x0, "m")
         _checks.non_negative("y0", self.y0, "m", "the ground is y = 0")
+        with np.errstate(all="ignore"):
+            flight = (self.flight_time, self.range, self.max_height, self.x0 + self.range)
+        if not all(math.isfinite(value) for value in flight):
+            sizes = {"v0": self.v0, "g": self.g, "y0": self.y0}
+            name = max(sizes, key=lambda key: abs(math.log10(sizes[key])) if sizes[key] else 0)
+            raise _checks.fail(
+                name, sizes[name], "such that the flight time, range and height are finite",
+                remedy=f"with v0={self.v0!r} m/s, g={self.g!r} m/s² and y0={self.y0!r} m they "
+                "overflow past 1.8e308; give the launch in other units",
+            )  # fmt: skip
 
     @property
     def flight_time(self) -> float:
@@ -94,16 +110,20 @@ class Projectile:
     def position(self, t: ArrayLike) -> np.ndarray:
         """(x, y) in m at times t (s); shape (2,) for scalar t, (n, 2) for t of shape (n,)."""
         t, scalar = _times(t)
-        x = self.x0 + self.v0 * np.cos(self.angle) * t
-        y = self.y0 + self.v0 * np.sin(self.angle) * t - 0.5 * self.g * t * t
-        return _shaped(np.stack([x, y], axis=-1), scalar)
+        with np.errstate(over="ignore", invalid="ignore"):
+            x = self.x0 + self.v0 * np.cos(self.angle) * t
+            y = self.y0 + self.v0 * np.sin(self.angle) * t - 0.5 * self.g * t * t
+        position = np.stack([x, y], axis=-1)
+        return _shaped(_finite(position, "t", t, "g t²/2 or v0 t overflows"), scalar)
 
     def velocity(self, t: ArrayLike) -> np.ndarray:
         """(vx, vy) in m/s at times t (s); shape (2,) or (n, 2) like `position`."""
         t, scalar = _times(t)
         vx = np.full_like(t, self.v0 * np.cos(self.angle))
-        vy = self.v0 * np.sin(self.angle) - self.g * t
-        return _shaped(np.stack([vx, vy], axis=-1), scalar)
+        with np.errstate(over="ignore"):
+            vy = self.v0 * np.sin(self.angle) - self.g * t
+        velocity = np.stack([vx, vy], axis=-1)
+        return _shaped(_finite(velocity, "t", t, "g t overflows"), scalar)
 
 
 def projectile(
@@ -173,7 +193,9 @@ def sphere(t: ArrayLike, omega0: ArrayLike = (1.0, 0.0, 0.0)) -> np.ndarray:
     """
     t, scalar = _times(t)
     omega0 = _vector("omega0", omega0)
-    return _shaped(rodrigues(omega0, t), scalar)
+    with np.errstate(over="ignore", invalid="ignore"):
+        R = rodrigues(omega0, t)
+    return _shaped(_past_overflow(R), scalar)
 
 
 def free_body(inertia: ArrayLike, omega0: ArrayLike, t: ArrayLike) -> np.ndarray:
@@ -228,8 +250,11 @@ def free_body(inertia: ArrayLike, omega0: ArrayLike, t: ArrayLike) -> np.ndarray
     ((2, 3), True)
     """
     t, scalar = _times(t)
-    moments, axes = principal_axes(inertia)
-    return _shaped(body_omega(moments, axes, _vector("omega0", omega0), t), scalar)
+    moments, axes = principal_axes(_inertia(inertia))
+    omega0 = _vector("omega0", omega0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        omega = body_omega(moments, axes, omega0, t)
+    return _shaped(_past_overflow(omega), scalar)
 
 
 def free_body_period(inertia: ArrayLike, omega0: ArrayLike) -> float:
@@ -262,8 +287,14 @@ def free_body_period(inertia: ArrayLike, omega0: ArrayLike) -> float:
     >>> round(free_body_period([1.0, 1.0, 2.0], [0.3, 0.0, 1.0]), 12) == round(2 * np.pi, 12)
     True
     """
-    moments, axes = principal_axes(inertia)
-    return body_period(moments, axes, _vector("omega0", omega0))
+    moments, axes = principal_axes(_inertia(inertia))
+    omega0 = _vector("omega0", omega0)
+    with np.errstate(over="ignore", invalid="ignore", under="ignore"):
+        period = body_period(moments, axes, omega0)
+    if math.isnan(period):  # |ω0|² under- or overflows: no digit of the energy is left
+        raise _checks.fail("omega0", omega0.tolist(), "a spin whose energy ½ ω·Iω is a normal "
+                           "float", "rad/s", remedy="give it in other units")  # fmt: skip
+    return period
 
 
 def free_body_rotation(
@@ -311,9 +342,13 @@ def free_body_rotation(
     True
     """
     t, scalar = _times(t)
-    moments, axes = principal_axes(inertia)
+    moments, axes = principal_axes(_inertia(inertia))
+    R0 = None if R0 is None else _checks.array("R0", so3.from_scipy(R0, "R0", single=True),
+                                               shape=(3, 3))  # fmt: skip
     omega0, R0 = _vector("omega0", omega0), check_rotation("R0", R0)
-    return _shaped(body_rotation(moments, axes, omega0, R0, t), scalar)
+    with np.errstate(over="ignore", invalid="ignore"):
+        R = body_rotation(moments, axes, omega0, R0, t)
+    return _shaped(_past_overflow(R), scalar)
 
 
 def observed_order(step_sizes: ArrayLike, errors: ArrayLike) -> float:
@@ -375,6 +410,7 @@ def measure_order(
     >>> round(order, 12)
     2.0
     """
+    run = _checks.function("run", run, "a callable run(h) -> error")
     h = _checks.values("step_sizes", step_sizes, minimum=2, unit="s", positive=True)
     errors = np.array([trial.error for trial in study(run, h, error=float)])
     return observed_order(h, errors), errors
@@ -422,7 +458,8 @@ def study(
     ``warm_up()`` once (numba's compilation and the first call's imports are not timed), then
     for each setting the best time of ``repeat`` calls ``run(setting)`` (the least disturbed
     by other work) and ``error`` of the fastest; a non-finite error (a run that blew up or
-    stopped) is ``inf``.
+    stopped) is ``inf``. Its runs take coarse steps on purpose: a
+    :class:`~tumble._checks.LargeStepWarning` is not shown for them (each error says it).
 
     Parameters
     ----------
@@ -455,11 +492,28 @@ def study(
     >>> [round(trial.error, 6) for trial in trials]
     [0.03, 0.0075]
     """
+    run = _checks.function("run", run, "a callable run(setting) -> result")
+    given = _checks.array("settings", settings)
+    if given.ndim != 1:
+        raise _checks.fail("settings", settings, "a 1-D sequence of numbers (steps or "
+                           "tolerances)")  # fmt: skip
+    for name, value in (("error", error), ("warm_up", warm_up), ("seconds", seconds),
+                        ("until", until)):  # fmt: skip
+        if value is not None:
+            _checks.function(name, value, "None or a callable")
     repeat = _checks.count("repeat", repeat)
+    with warnings.catch_warnings():  # coarse steps on purpose: the errors say how coarse
+        warnings.simplefilter("ignore", _checks.LargeStepWarning)
+        return _trials(run, given.tolist(), error, repeat, warm_up, seconds, until)
+
+
+def _trials(run, settings: list[float], error, repeat: int, warm_up, seconds,
+            until) -> list[Trial]:  # fmt: skip
+    """:func:`study`'s runs, its arguments checked."""
     if warm_up is not None:
         warm_up()
-    trials: list[Trial[R]] = []
-    for setting in np.asarray(settings, dtype=float).tolist():
+    trials: list[Trial] = []
+    for setting in settings:
         best, fastest = math.inf, None
         for _ in range(repeat):
             start = time.perf_counter()
@@ -556,14 +610,16 @@ def fit_order(
     >>> round(fit.order, 12), fit.points
     (4.0, 3)
     """
-    h = np.asarray(step_sizes, dtype=float)
-    e = np.asarray(errors, dtype=float)
+    h = _checks.values("step_sizes", step_sizes, minimum=1, unit="s", positive=True)
+    e = _checks.array("errors", errors, finite=False)  # inf or NaN: a failed run
     if e.shape != h.shape:
         raise _checks.fail("errors", errors, f"one value per step size ({h.size})")
-    if minimum < 2:
-        raise _checks.fail("minimum", minimum, "at least 2 (a slope needs two steps)")
+    minimum = _checks.count("minimum", minimum, 2, remedy="a slope needs two steps")
+    if finest is not None:
+        finest = _checks.count("finest", finest)
+    floor, ceiling = _window(window)
     with np.errstate(invalid="ignore"):
-        inside = np.isfinite(e) & (e > window[0]) & (e < window[1])
+        inside = np.isfinite(e) & (e > floor) & (e < ceiling)
     by_step = np.argsort(h, kind="stable")
     chosen = by_step[inside[by_step]][:finest]
     if np.unique(h[chosen]).size < minimum:
@@ -588,3 +644,39 @@ def _shaped(out: np.ndarray, scalar: bool) -> np.ndarray:
 
 def _vector(name: str, value: ArrayLike) -> np.ndarray:
     return _checks.array(name, value, shape=(3,), unit="rad/s")
+
+
+def _inertia(value: ArrayLike) -> np.ndarray:
+    """``inertia`` as numbers (its shape and values are checked by ``principal_axes``)."""
+    return _checks.array("inertia", value, unit="kg m²")
+
+
+def _finite(result: np.ndarray, name: str, value: np.ndarray, cause: str) -> np.ndarray:
+    """``result``, or the ValueError naming ``name`` when an entry is not finite (an input
+    so large that the closed form overflows)."""
+    if np.count_nonzero(np.isfinite(result)) != result.size:
+        raise _checks.fail(name, value.tolist(), "small enough that the result is finite",
+                           remedy=f"{cause} past 1.8e308; give it in other units")  # fmt: skip
+    return result
+
+
+def _past_overflow(result: np.ndarray) -> np.ndarray:
+    """A reference past the range of doubles (a spin whose angle or energy overflows) as NaN,
+    without NumPy's warnings: a run compared with it is then said to have failed, by its
+    status, not by an exception from the reference."""
+    result[~np.isfinite(result)] = np.nan
+    return result
+
+
+def _window(window: Any) -> tuple[float, float]:
+    """``(floor, ceiling)`` of :func:`fit_order`: numbers, ``0 <= floor < ceiling``."""
+    allowed = "a pair (floor, ceiling) of errors, 0 <= floor < ceiling (ceiling may be inf)"
+    try:
+        if isinstance(window, str | bytes):
+            raise TypeError
+        floor, ceiling = (float(x) for x in window)
+    except (TypeError, ValueError):
+        raise _checks.fail("window", window, allowed) from None
+    if not (0 <= floor < ceiling and math.isfinite(floor)):
+        raise _checks.fail("window", window, allowed)
+    return floor, ceiling

@@ -404,6 +404,19 @@ def load(path: str | Path) -> Run:
             f"path={str(path)!r}: {DATA_FILE} could not be read ({reason}); it is damaged or not "
             "a netCDF-4 file written by tumble: run the scenario again"
         )
+    shared = [
+        key
+        for key, value in data.attrs.items()
+        if key in summary and np.ndim(value) == 0 and isinstance(summary[key], str | int | float)
+        and summary[key] == summary[key]  # not NaN
+    ]  # fmt: skip
+    differ = [key for key in shared if not summary[key] == data.attrs[key]]
+    if differ:  # summary.json and data.nc of two runs (the README: checked against each other)
+        key, written = differ[0], np.asarray(data.attrs[differ[0]]).item()
+        raise ValueError(
+            f"path={str(path)!r} mixes two runs: {SUMMARY_FILE} has {key}={summary[key]!r} and "
+            f"{DATA_FILE} {key}={written!r}; copy both files of one run, or run it again"
+        )
     return Run(folder, summary, data)
 
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from tumble import _checks
+from tumble import _checks, so3
 from tumble.so3 import validate_rotation
 
 SYMMETRY_RTOL = 1e-9
@@ -94,8 +94,11 @@ def validate_inertia(
     scale = np.max(np.abs(value))
     if np.max(np.abs(value - value.T)) > SYMMETRY_RTOL * scale:
         raise _checks.fail(name, value.tolist(), "symmetric", "kg m²")
-    value = 0.5 * (value + value.T)
-    moments = np.linalg.eigvalsh(value)
+    value = 0.5 * value + 0.5 * value.T  # (not (I + Iᵀ)/2: it overflows past 9e307)
+    if scale == 0.0:
+        raise _checks.fail(name, value.tolist(), "positive definite", "kg m²",
+                           "its principal moments are [0.0, 0.0, 0.0]")  # fmt: skip
+    moments = np.linalg.eigvalsh(value / scale) * scale  # scaled: LAPACK fails past ~1e154
     if moments[0] <= 0.0:
         raise _checks.fail(
             name,
@@ -104,7 +107,7 @@ def validate_inertia(
             "kg m²",
             f"its principal moments are {moments.tolist()}",
         )
-    if not allow_unphysical and moments[0] + moments[1] < moments[2] * (1 - TRIANGLE_RTOL):
+    if not allow_unphysical and moments[0] < moments[2] * (1 - TRIANGLE_RTOL) - moments[1]:
         raise _checks.fail(
             name,
             value.tolist(),
@@ -129,11 +132,21 @@ def axis_vector(axis: str | ArrayLike, *, name: str = "axis") -> Array:
         if axis not in AXES:
             raise _checks.fail(name, axis, allowed)
         return np.array(AXES[axis])
-    vector = np.asarray(axis, dtype=float)
-    norm = np.linalg.norm(vector) if vector.shape == (3,) else 0.0
-    if not (np.isfinite(norm) and norm > 0.0):
+    try:
+        vector = _checks.array(name, axis, shape=(3,))
+    except ValueError:
+        raise _checks.fail(name, axis, allowed) from None
+    largest = float(np.max(np.abs(vector)))
+    if largest == 0.0:
         raise _checks.fail(name, axis, allowed)
-    return vector / norm
+    vector = vector / largest  # |v|² of [1e308, 1e308, 0] would overflow
+    return vector / np.linalg.norm(vector)
+
+
+def rotation_matrix(value: ArrayLike, name: str) -> Array:
+    """``value`` as one rotation matrix (3, 3) (a single scipy ``Rotation`` too), checked."""
+    R = _checks.array(name, so3.from_scipy(value, name, single=True), shape=(3, 3))
+    return validate_rotation(R, name=name)
 
 
 def validate_point(value: ArrayLike, *, name: str) -> Array:
@@ -186,7 +199,8 @@ class MassProperties:
     allow_unphysical: bool = field(default=False, kw_only=True)
 
     def __post_init__(self) -> None:
-        inertia = validate_inertia(self.inertia, allow_unphysical=self.allow_unphysical)
+        unphysical = _checks.flag("allow_unphysical", self.allow_unphysical)
+        inertia = validate_inertia(self.inertia, allow_unphysical=unphysical)
         object.__setattr__(self, "mass", validate_mass(self.mass))
         object.__setattr__(self, "com", _read_only(validate_point(self.com, name="com")))
         object.__setattr__(self, "inertia", _read_only(inertia))
@@ -217,14 +231,20 @@ class MassProperties:
 
     def rotated(self, rotation: ArrayLike) -> MassProperties:
         """The body rotated about the origin: ``com -> R com``, ``I -> R I Rᵀ``."""
-        R = validate_rotation(rotation, name="rotation")
+        R = rotation_matrix(rotation, "rotation")
         return MassProperties(
             self.mass, R @ self.com, R @ self.inertia @ R.T, allow_unphysical=self.allow_unphysical
         )
 
     def inertia_about(self, point: ArrayLike) -> Array:
         """Inertia (kg m²) about ``point``: ``I + m (|d|² 1 - d dᵀ)``, ``d = com - point``."""
-        return self.inertia + _shift(self.mass, self.com - validate_point(point, name="point"))
+        d = self.com - validate_point(point, name="point")
+        with np.errstate(over="ignore", invalid="ignore"):
+            inertia = self.inertia + _shift(self.mass, d)
+        if np.count_nonzero(np.isfinite(inertia)) != 9:
+            raise _checks.fail("point", point, "a point whose inertia about it is finite", "m",
+                               remedy="m |d|² overflows past 1.8e308")  # fmt: skip
+        return inertia
 
     def principal(self) -> tuple[Array, Array]:
         """Principal moments (ascending, kg m²) and axes (columns, right-handed).
@@ -277,6 +297,8 @@ def _sized(
         return _checks.fail(name, arguments[name][0], allowed, arguments[name][1], remedy)
 
     def check(m: float, *moments: float) -> None:
+        if math.isnan(m):
+            raise refuse("a part's mass or moment of inertia is not a float > 0")
         if not 0 < m < math.inf:
             raise refuse(f"the mass is {m:g} kg")
         for moment in moments:
@@ -493,11 +515,19 @@ def t_handle(
     >>> round(body.mass, 7), np.allclose(body.com, 0.0)
     (0.252584, True)
     """
-    handle = cylinder(
-        handle_radius, handle_length, density=density, axis="y", center=(-handle_radius, 0, 0)
-    )
-    shaft = cylinder(
-        shaft_radius, shaft_length, density=density, axis="x", center=(shaft_length / 2, 0, 0)
-    )
-    body = handle + shaft
+    sizes = {"handle_radius": handle_radius, "handle_length": handle_length,
+             "shaft_radius": shaft_radius, "shaft_length": shaft_length}  # fmt: skip
+    for name, value in sizes.items():
+        sizes[name] = _checks.positive(name, value, "m")
+    density = _checks.positive("density", density, "kg/m³")
+    with _sized(density, None, **sizes) as check:
+        try:
+            handle = cylinder(sizes["handle_radius"], sizes["handle_length"], density=density,
+                              axis="y", center=(-sizes["handle_radius"], 0, 0))  # fmt: skip
+            shaft = cylinder(sizes["shaft_radius"], sizes["shaft_length"], density=density,
+                             axis="x", center=(sizes["shaft_length"] / 2, 0, 0))  # fmt: skip
+            body = handle + shaft
+        except ValueError:  # a part's mass or moment is not a float: named as t_handle's
+            check(math.nan)
+        check(body.mass, *np.linalg.eigvalsh(body.inertia))
     return body.translated(-body.com)

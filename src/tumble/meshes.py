@@ -19,8 +19,13 @@ from numpy.typing import ArrayLike
 
 from tumble import _checks, _mesh_files, _parts
 from tumble._atomic import atomic_write
-from tumble.mass import MassProperties, axis_vector, validate_point, validate_torus_radii
-from tumble.so3 import validate_rotation
+from tumble.mass import (
+    MassProperties,
+    axis_vector,
+    rotation_matrix,
+    validate_point,
+    validate_torus_radii,
+)
 
 if TYPE_CHECKING:
     import trimesh
@@ -33,6 +38,37 @@ SAVE_FORMATS = ("glb", "obj", "off", "ply", "stl")
 """File extensions :func:`save` writes (trimesh's mesh exporters)."""
 TEXT_FORMATS = ("gltf", "obj", "off")
 """Formats that are text: a file of one whose bytes are not UTF-8 is refused as such."""
+FACE_BYTES = 256
+"""Memory a generated triangle takes, with margin: trimesh's peak resident memory measured
+127–132 bytes a face for a 1.3·10⁶-face icosphere and a 2·10⁶-face torus."""
+
+
+def _max_faces() -> int:
+    """The most triangles a generator makes: what fits in half this machine's memory."""
+    return int(0.5 * _checks.memory() / FACE_BYTES)
+
+
+def _faces(name: str, value: object, minimum: int, faces_per_unit: int, other: int = 1) -> int:
+    """A section count checked: an integer >= ``minimum`` whose mesh of about
+    ``faces_per_unit · value · other`` triangles fits in memory (:func:`_max_faces`)."""
+    limit = max(minimum, _max_faces() // (faces_per_unit * other))
+    return _checks.count(name, value, minimum, limit,
+                         remedy=f"more would need over {_max_faces():.3g} triangles")  # fmt: skip
+
+
+def _finite_mesh(mesh: trimesh.Trimesh, sizes: dict[str, float]) -> trimesh.Trimesh:
+    """``mesh``, or the ValueError naming the size (of ``sizes``) furthest from 1 when a
+    vertex coordinate overflowed (or an edge underflowed to a point)."""
+    with np.errstate(all="ignore"):
+        extents = mesh.extents  # None for a mesh whose vertices all merged
+        good = np.count_nonzero(np.isfinite(mesh.vertices)) == mesh.vertices.size
+        good = good and extents is not None and bool(np.all(extents > 0)) and mesh.is_watertight
+    if good:
+        return mesh
+    name = max(sizes, key=lambda key: abs(np.log10(sizes[key])))
+    raise _checks.fail(name, sizes[name], "a size whose mesh has finite, distinct vertices", "m",
+                       remedy="past ~1e154 m (or below ~1e-154 m) the vertices overflow or "
+                       "collapse; give the body in other units")  # fmt: skip
 
 
 def _placement(axis: str | ArrayLike, center: ArrayLike) -> np.ndarray:
@@ -79,11 +115,16 @@ def torus(
     import trimesh
 
     R, r = validate_torus_radii(major_radius, minor_radius)
-    n = _checks.count("sections", sections, 3)
-    k = n if minor_sections is None else _checks.count("minor_sections", minor_sections, 3)
-    return trimesh.creation.torus(
-        R, r, major_sections=n, minor_sections=k, transform=_placement(axis, center)
-    )
+    n = _faces("sections", sections, 3, 2, 3)
+    k = n if minor_sections is None else _faces("minor_sections", minor_sections, 3, 2, n)
+    if minor_sections is None and 2 * n * n > _max_faces():
+        raise _checks.fail("sections", sections, f"at most {int((_max_faces() / 2) ** 0.5)} "
+                           "when minor_sections is None (n² triangles)")  # fmt: skip
+    with np.errstate(all="ignore"):
+        mesh = trimesh.creation.torus(
+            R, r, major_sections=n, minor_sections=k, transform=_placement(axis, center)
+        )
+    return _finite_mesh(mesh, {"major_radius": R, "minor_radius": r})
 
 
 def cylinder(
@@ -106,10 +147,12 @@ def cylinder(
 
     a = _checks.positive("radius", radius, "m")
     L = _checks.positive("length", length, "m")
-    n = _checks.count("sections", sections, 3)
-    return trimesh.creation.cylinder(
-        radius=a, height=L, sections=n, transform=_placement(axis, center)
-    )
+    n = _faces("sections", sections, 3, 4)
+    with np.errstate(all="ignore"):
+        mesh = trimesh.creation.cylinder(
+            radius=a, height=L, sections=n, transform=_placement(axis, center)
+        )
+    return _finite_mesh(mesh, {"radius": a, "length": L})
 
 
 def hex_prism(
@@ -126,7 +169,12 @@ def hex_prism(
     >>> bool(np.isclose(hex_prism(1.0, 1.0).volume, 1.5 * np.sqrt(3.0), rtol=1e-14))
     True
     """
-    return cylinder(circumradius, length, 6, axis=axis, center=center)
+    a = _checks.positive("circumradius", circumradius, "m")
+    L = _checks.positive("length", length, "m")
+    try:
+        return cylinder(a, L, 6, axis=axis, center=center)
+    except ValueError as error:  # named as the cylinder's radius: name it as given here
+        raise ValueError(str(error).replace("radius=", "circumradius=", 1)) from None
 
 
 def box(
@@ -147,9 +195,11 @@ def box(
     sides = _checks.array("extents", extents, shape=(3,), unit="m", positive=True)
     transform = np.eye(4)
     if rotation is not None:
-        transform[:3, :3] = validate_rotation(rotation, name="rotation")
+        transform[:3, :3] = rotation_matrix(rotation, "rotation")
     transform[:3, 3] = validate_point(center, name="center")
-    return trimesh.creation.box(extents=sides, transform=transform)
+    with np.errstate(all="ignore"):
+        mesh = trimesh.creation.box(extents=sides, transform=transform)
+    return _finite_mesh(mesh, {f"extents[{i}]": float(side) for i, side in enumerate(sides)})
 
 
 def sphere(
@@ -165,9 +215,14 @@ def sphere(
     import trimesh
 
     a = _checks.positive("radius", radius, "m")
-    subdivisions = _checks.count("subdivisions", subdivisions, 0)
-    mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=a)
-    return mesh.apply_translation(validate_point(center, name="center"))
+    most = max(0, int(np.log(max(_max_faces() / 20, 1)) / np.log(4)))  # 20·4^s triangles
+    subdivisions = _checks.count("subdivisions", subdivisions, 0, most,
+                                 remedy=f"{most + 1} would make over {_max_faces():.3g} "
+                                 "triangles")  # fmt: skip
+    with np.errstate(all="ignore"):
+        mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=a)
+        mesh = mesh.apply_translation(validate_point(center, name="center"))
+    return _finite_mesh(mesh, {"radius": a})
 
 
 def t_handle(sections: int = DEFAULT_SECTIONS) -> trimesh.Trimesh:
@@ -186,6 +241,7 @@ def t_handle(sections: int = DEFAULT_SECTIONS) -> trimesh.Trimesh:
     """
     import trimesh
 
+    sections = _faces("sections", sections, 3, 8)
     handle = cylinder(0.01, 0.08, sections, axis="y", center=(-0.01, 0.0, 0.0))
     shaft = cylinder(0.01, 0.04, sections, axis="x", center=(0.02, 0.0, 0.0))
     return trimesh.util.concatenate([handle, shaft])  # type: ignore[return-value]  # annotated Geometry
@@ -273,16 +329,24 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
     ...     print(round(float(load(path).volume), 9))
     6.0
     """
+    return _load(path, "path")
+
+
+def _load(path: str | PathLike[str], name: str) -> trimesh.Trimesh:
+    """:func:`load`, its messages naming the argument ``name``."""
     import trimesh
 
-    file = Path(path)
+    file = _checks.path(name, path, "a mesh file")
     if not file.is_file():
-        raise _checks.fail("path", str(path), "an existing mesh file", remedy="not found")
-    file_type = _suffix(file, LOAD_FORMATS, "path")
-    if file_type == "stl":
-        _mesh_files.check_stl(file, path)
-    elif file_type in TEXT_FORMATS:
-        _mesh_files.check_text(file, path, file_type)
+        raise _checks.fail(name, str(path), "an existing mesh file", remedy="not found")
+    file_type = _suffix(file, LOAD_FORMATS, name)
+    try:
+        if file_type == "stl":
+            _mesh_files.check_stl(file, path)
+        elif file_type in TEXT_FORMATS:
+            _mesh_files.check_text(file, path, file_type)
+    except ValueError as error:  # _mesh_files names the file "path"
+        raise ValueError(str(error).replace("path=", f"{name}=", 1)) from None
     try:
         mesh = trimesh.load_mesh(file, file_type=file_type, process=False)
     except Exception as error:  # trimesh raises many types for a bad file
@@ -292,16 +356,16 @@ def load(path: str | PathLike[str]) -> trimesh.Trimesh:
             else str(error)
         )
         raise _checks.fail(
-            "path", str(path), f"a readable {file_type} mesh file", remedy=f"reading it: {cause}"
+            name, str(path), f"a readable {file_type} mesh file", remedy=f"reading it: {cause}"
         ) from error
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise _checks.fail(
-            "path",
+            name,
             str(path),
             "a mesh file with triangles",
             remedy=f"it has none (empty or not a {file_type} file)",
         )
-    _check_finite(mesh, "path", str(path), "a mesh file with finite vertex coordinates")
+    _check_finite(mesh, name, str(path), "a mesh file with finite vertex coordinates")
     return _mesh_files.merged(mesh)
 
 
@@ -336,7 +400,7 @@ def save(mesh: trimesh.Trimesh, path: str | PathLike[str]) -> Path:
 
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise _checks.fail("mesh", mesh, "a trimesh.Trimesh with faces")
-    file = Path(path)
+    file = _checks.path("path", path, "a mesh file to write")
     file_type = _suffix(file, SAVE_FORMATS, "path")
     if not file.parent.is_dir():
         raise _checks.fail("path", str(path), "a file in an existing folder")
@@ -384,9 +448,10 @@ def from_mesh(
     import trimesh
 
     rho = _checks.positive("density", density, "kg/m³")
+    fix_inside_out = _checks.flag("fix_inside_out", fix_inside_out)
     given = str(mesh_or_path) if isinstance(mesh_or_path, PathLike) else mesh_or_path
     if isinstance(mesh_or_path, (str, PathLike)):
-        mesh_or_path = load(mesh_or_path)
+        mesh_or_path = _load(mesh_or_path, "mesh_or_path")
     mesh = validate_solid(mesh_or_path, name="mesh_or_path")
     triangles = _parts.oriented(
         mesh.triangles, mesh.faces, name="mesh_or_path", value=given, fix_inside_out=fix_inside_out

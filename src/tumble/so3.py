@@ -11,9 +11,19 @@ The derivative of the exponential (``dexp``, ``dexpinv``) is in the *left-trivia
 form of Iserles, Munthe-Kaas, Nørsett & Zanna (2000): ``d/dt exp(u) = hat(dexp(u) u') exp(u)``.
 For the body-frame equation ``X' = X hat(Omega)`` write ``X = X0 exp(u)`` and integrate
 ``u' = dexpinv(-u) Omega``; see :func:`dexp` and ``docs/rotations.md``.
+
+Every function checks the shape of its arguments (a ValueError names the argument) and
+takes a ``scipy.spatial.transform.Rotation`` wherever it takes rotation matrices. Like
+NumPy's own functions they do not check the entries: a NaN or inf gives NaN, and so does a
+rotation vector past ~1e154 rad (its angle has no digit left modulo 2π). The functions that
+must divide by a norm (:func:`quat_normalize` and those that normalise first, :func:`log`)
+refuse a quaternion or matrix they cannot normalise.
 """
 
 from __future__ import annotations
+
+import math
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -47,7 +57,7 @@ def hat(w: ArrayLike) -> Array:
     >>> hat([1.0, 2.0, 3.0]) @ [0.0, 0.0, 1.0]
     array([ 2., -1.,  0.])
     """
-    w = np.asarray(w, dtype=float)
+    w = _vectors("w", w)
     x, y, z = w[..., 0], w[..., 1], w[..., 2]
     zero = np.zeros_like(x)
     rows = [np.stack(r, axis=-1) for r in ((zero, -z, y), (z, zero, -x), (-y, x, zero))]
@@ -71,7 +81,7 @@ def vee(W: ArrayLike) -> Array:
     >>> vee(hat([1.0, 2.0, 3.0]))
     array([1., 2., 3.])
     """
-    W = np.asarray(W, dtype=float)
+    W = _matrices("W", W)
     return 0.5 * np.stack(
         [W[..., 2, 1] - W[..., 1, 2], W[..., 0, 2] - W[..., 2, 0], W[..., 1, 0] - W[..., 0, 1]],
         axis=-1,
@@ -106,7 +116,7 @@ def exp(w: ArrayLike) -> Array:
     >>> np.round(exp([0.0, 0.0, np.pi / 2]) @ [1.0, 0.0, 0.0], 12) + 0.0  # x turns to y
     array([0., 1., 0.])
     """
-    w = np.asarray(w, dtype=float)
+    w = _vectors("w", w)
     t = np.linalg.norm(w, axis=-1)
     a = _sinc(t)[..., None, None]
     b = (0.5 * _sinc(0.5 * t) ** 2)[..., None, None]
@@ -135,7 +145,14 @@ def log(R: ArrayLike) -> Array:
     >>> np.round(log(exp([0.1, -0.2, 0.3])), 12)
     array([ 0.1, -0.2,  0.3])
     """
-    return rotvec_from_quat(quat_from_matrix(R))
+    R = _matrices("R", R)
+    with np.errstate(all="ignore"):
+        q = quat_from_matrix(R)
+    bad = np.isfinite(q).sum(axis=-1) != 4
+    if np.any(bad):  # a NaN or inf in R, or entries past ~1e154 (its trace overflows)
+        index = _first(bad)
+        raise _checks.fail(_label("R", index), R[index].tolist(), "a rotation matrix, finite")
+    return rotvec_from_quat(q)
 
 
 def _coefficient_b(t: Array) -> Array:
@@ -185,7 +202,7 @@ def dexp(u: ArrayLike) -> Array:
     >>> np.allclose(dexp([0.3, 0.1, -0.2]) @ dexpinv([0.3, 0.1, -0.2]), np.eye(3))
     True
     """
-    u = np.asarray(u, dtype=float)
+    u = _vectors("u", u)
     t = np.linalg.norm(u, axis=-1)
     K = hat(u)
     return (
@@ -220,7 +237,7 @@ def dexpinv(u: ArrayLike) -> Array:
     >>> np.allclose(dexpinv([0.0, 0.0, 0.0]), np.eye(3))
     True
     """
-    u = np.asarray(u, dtype=float)
+    u = _vectors("u", u)
     K = hat(u)
     return (
         np.eye(3) - 0.5 * K + _coefficient_d(np.linalg.norm(u, axis=-1))[..., None, None] * (K @ K)
@@ -244,8 +261,7 @@ def dexpinv_apply(u: ArrayLike, v: ArrayLike) -> Array:
     >>> np.allclose(dexpinv_apply(u, v), dexpinv(u) @ v)
     True
     """
-    u = np.asarray(u, dtype=float)
-    v = np.asarray(v, dtype=float)
+    u, v = _pair("u", u, "v", v, (3,), "3-vectors")
     uv = np.cross(u, v)
     return v - 0.5 * uv + _coefficient_d(np.linalg.norm(u, axis=-1))[..., None] * np.cross(u, uv)
 
@@ -269,8 +285,7 @@ def quat_mul(p: ArrayLike, q: ArrayLike) -> Array:
     >>> quat_mul([0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0])  # i j = k
     array([0., 0., 0., 1.])
     """
-    p = np.asarray(p, dtype=float)
-    q = np.asarray(q, dtype=float)
+    p, q = _pair("p", p, "q", q, (4,), "quaternions [w, x, y, z]")
     pw, pv, qw, qv = p[..., :1], p[..., 1:], q[..., :1], q[..., 1:]
     w = pw * qw - np.sum(pv * qv, axis=-1, keepdims=True)
     return np.concatenate([w, pw * qv + qw * pv + np.cross(pv, qv)], axis=-1)
@@ -292,7 +307,7 @@ def quat_conj(q: ArrayLike) -> Array:
     >>> quat_conj([1.0, 2.0, 3.0, 4.0])
     array([ 1., -2., -3., -4.])
     """
-    return np.asarray(q, dtype=float) * np.array([1.0, -1.0, -1.0, -1.0])
+    return _quaternions("q", q) * np.array([1.0, -1.0, -1.0, -1.0])
 
 
 def quat_normalize(q: ArrayLike, *, name: str = "q") -> Array:
@@ -318,13 +333,15 @@ def quat_normalize(q: ArrayLike, *, name: str = "q") -> Array:
     >>> quat_normalize([2.0, 0.0, 0.0, 0.0])
     array([1., 0., 0., 0.])
     """
-    q = np.asarray(q, dtype=float)
-    if q.shape[-1:] != (4,):
-        raise _checks.fail(
-            name, q, "of shape (..., 4), [w, x, y, z]", remedy=f"it has shape {q.shape}"
-        )
-    norm = np.linalg.norm(q, axis=-1, keepdims=True)
+    q = _quaternions(name, q)
+    with np.errstate(over="ignore", invalid="ignore"):
+        norm = np.linalg.norm(q, axis=-1, keepdims=True)
     bad = ~np.isfinite(norm[..., 0]) | (norm[..., 0] == 0.0)
+    if np.any(bad):  # |q|² past 1.8e308 overflows: the norm again, of q scaled to 1
+        with np.errstate(all="ignore"):
+            largest = np.max(np.abs(q), axis=-1, keepdims=True)
+            norm = np.linalg.norm(q / largest, axis=-1, keepdims=True) * largest
+        bad = ~np.isfinite(norm[..., 0]) | (norm[..., 0] == 0.0)
     if np.any(bad):
         index = _first(bad)
         raise _checks.fail(
@@ -380,7 +397,7 @@ def quat_from_matrix(R: ArrayLike) -> Array:
     >>> np.round(quat_from_matrix(np.diag([1.0, -1.0, -1.0])), 12) + 0.0
     array([0., 1., 0., 0.])
     """
-    m = np.moveaxis(np.asarray(R, dtype=float), (-2, -1), (0, 1))  # m[i, j] is R[..., i, j]
+    m = np.moveaxis(_matrices("R", R), (-2, -1), (0, 1))  # m[i, j] is R[..., i, j]
     trace = m[0, 0] + m[1, 1] + m[2, 2]
     s01, s02, s12 = m[1, 0] + m[0, 1], m[0, 2] + m[2, 0], m[2, 1] + m[1, 2]
     a21, a02, a10 = m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]
@@ -416,7 +433,7 @@ def quat_from_rotvec(w: ArrayLike) -> Array:
     >>> np.round(quat_from_rotvec([np.pi, 0.0, 0.0]), 12) + 0.0
     array([0., 1., 0., 0.])
     """
-    w = np.asarray(w, dtype=float)
+    w = _vectors("w", w)
     half = 0.5 * np.linalg.norm(w, axis=-1)
     return np.concatenate([np.cos(half)[..., None], (0.5 * _sinc(half))[..., None] * w], -1)
 
@@ -463,7 +480,7 @@ def matrix_from_euler_zyx(angles: ArrayLike) -> Array:
     >>> np.allclose(matrix_from_euler_zyx([0.3, 0.0, 0.0]), exp([0.0, 0.0, 0.3]))
     True
     """
-    angles = np.asarray(angles, dtype=float)
+    angles = _vectors("angles", angles, "ZYX angles [phi_z, theta_y, psi_x]")
     e = np.eye(3)
     return (
         exp(angles[..., 0, None] * e[2])
@@ -496,7 +513,7 @@ def euler_zyx_from_matrix(R: ArrayLike) -> Array:
     >>> np.round(euler_zyx_from_matrix(matrix_from_euler_zyx([0.3, -0.2, 0.1])), 12)
     array([ 0.3, -0.2,  0.1])
     """
-    R = np.asarray(R, dtype=float)
+    R = _matrices("R", R)
     cos_theta = np.hypot(R[..., 0, 0], R[..., 1, 0])
     locked = cos_theta < GIMBAL_LOCK_TOL
     phi = np.where(
@@ -535,9 +552,30 @@ def random_rotation(
     >>> R.shape, np.allclose(R @ R.swapaxes(-1, -2), np.eye(3))
     ((2, 3, 3), True)
     """
-    rng = np.random.default_rng(rng)
-    shape = (size,) if isinstance(size, int) else tuple(size)
-    return matrix_from_quat(rng.standard_normal(shape + (4,)))
+    if not (rng is None or isinstance(rng, np.random.Generator)):
+        rng = _checks.count("rng", rng, 0, remedy="a seed, a numpy.random.Generator or None")
+    shape = _size(size)
+    return matrix_from_quat(np.random.default_rng(rng).standard_normal(shape + (4,)))
+
+
+def _size(size: object) -> tuple[int, ...]:
+    """``size`` of :func:`random_rotation` as a shape: an int or a tuple of ints >= 0, of at
+    most :data:`MAX_DRAWS` rotations."""
+    allowed = "an int or a tuple of ints >= 0 (the batch's shape)"
+    if isinstance(size, bool) or not isinstance(size, int | np.integer | tuple | list):
+        raise _checks.fail("size", size, allowed)
+    shape = (size,) if isinstance(size, int | np.integer) else tuple(size)
+    if not all(isinstance(n, int | np.integer) and not isinstance(n, bool) and n >= 0
+               for n in shape):  # fmt: skip
+        raise _checks.fail("size", size, allowed)
+    if math.prod(shape) > MAX_DRAWS:
+        raise _checks.fail("size", size, f"at most {MAX_DRAWS:.3g} rotations in all",
+                           remedy="draw them in batches")  # fmt: skip
+    return tuple(int(n) for n in shape)
+
+
+MAX_DRAWS = 10**8
+"""The most rotations :func:`random_rotation` draws in one call (7.2 GB of matrices)."""
 
 
 def validate_rotation(R: ArrayLike, *, name: str = "R", atol: float = 1e-9) -> Array:
@@ -567,11 +605,14 @@ def validate_rotation(R: ArrayLike, *, name: str = "R", atol: float = 1e-9) -> A
     >>> validate_rotation(np.eye(3)).shape
     (3, 3)
     """
-    R = np.asarray(R, dtype=float)
-    if R.shape[-2:] != (3, 3):
+    R = from_scipy(R, name)
+    atol = _checks.non_negative("atol", atol)
+    R = _checks.trailing(name, R, (3, 3), "rotation matrices")
+    if R.ndim < 2:
         raise _checks.fail(name, R, "of shape (..., 3, 3)", remedy=f"it has shape {R.shape}")
-    defect = np.max(np.abs(R.swapaxes(-1, -2) @ R - np.eye(3)), axis=(-2, -1))
-    det = np.linalg.det(R)
+    with np.errstate(all="ignore"):  # NaN or huge entries: refused below, by name
+        defect = np.max(np.abs(R.swapaxes(-1, -2) @ R - np.eye(3)), axis=(-2, -1))
+        det = np.linalg.det(R)
     bad = ~(defect <= atol) | ~(det > 0.0)  # NaN is bad too
     if np.any(bad):
         index = _first(bad)
@@ -583,6 +624,52 @@ def validate_rotation(R: ArrayLike, *, name: str = "R", atol: float = 1e-9) -> A
             f"re-orthonormalise, e.g. tumble.so3.exp(tumble.so3.log({name}))",
         )
     return R.copy()
+
+
+def from_scipy(value: Any, name: str, *, quaternion: bool = False, single: bool = False) -> Any:
+    """``value`` as an array if it is a ``scipy.spatial.transform.Rotation`` (its matrices,
+    or with ``quaternion`` its scalar-first quaternions ``[w, x, y, z]``); anything else as
+    it is. ``single``: a Rotation of several rotations is refused, naming ``name``.
+
+    Examples
+    --------
+    >>> from scipy.spatial.transform import Rotation
+    >>> from_scipy(Rotation.from_rotvec([0.0, 0.0, np.pi]), "R0", quaternion=True).round(12)
+    array([0., 0., 0., 1.])
+    """
+    if type(value).__name__ != "Rotation" or not hasattr(value, "as_matrix"):
+        return value
+    if single and not value.single:
+        raise _checks.fail(name, f"<Rotation of {len(value)}>", "a single rotation")
+    if quaternion:
+        return value.as_quat()[..., [3, 0, 1, 2]]  # scipy's is scalar last
+    return value.as_matrix()
+
+
+def _vectors(name: str, value: ArrayLike, what: str = "3-vectors") -> Array:
+    return _checks.trailing(name, value, (3,), what)
+
+
+def _matrices(name: str, value: ArrayLike) -> Array:
+    return _checks.trailing(name, from_scipy(value, name), (3, 3), "3×3 matrices")
+
+
+def _quaternions(name: str, value: ArrayLike) -> Array:
+    return _checks.trailing(name, value, (4,), "quaternions [w, x, y, z]")
+
+
+def _pair(first: str, a: ArrayLike, second: str, b: ArrayLike, shape: tuple[int, ...],
+          what: str) -> tuple[Array, Array]:  # fmt: skip
+    """Two arrays of items of ``shape`` whose leading axes broadcast together."""
+    a, b = _checks.trailing(first, a, shape, what), _checks.trailing(second, b, shape, what)
+    if a.shape[:-1] != b.shape[:-1]:
+        try:
+            np.broadcast_shapes(a.shape[:-1], b.shape[:-1])
+        except ValueError:
+            raise _checks.fail(second, b.tolist(), f"{what} whose batch shape broadcasts with "
+                               f"{first}'s, {a.shape[:-1]}", remedy=f"it has {b.shape[:-1]}"
+                               ) from None  # fmt: skip
+    return a, b
 
 
 def _first(bad: NDArray[np.bool_]) -> tuple[int, ...]:

@@ -179,7 +179,7 @@ def test_a_terminal_event_with_a_direction_stops_at_that_crossing():
                        events=[flip_event(body, terminal=2)])  # fmt: skip
     assert stopped.status == Status.TERMINAL_EVENT
     assert stopped.t[-1] == pytest.approx(every[1], rel=1e-12)
-    assert stopped.sol is None
+    assert not stopped.sol  # a terminal event keeps no dense output (a NoSolution)
 
 
 def test_an_event_that_is_zero_at_t0_does_not_fire_there():

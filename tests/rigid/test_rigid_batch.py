@@ -241,6 +241,7 @@ SOA = [name for name in FIXED if METHODS[name].family in SOA_FAMILIES]
 """The fixed-step methods whose batches run in the structure-of-arrays loops."""
 
 
+@pytest.mark.filterwarnings("ignore:h=.* turns the body:UserWarning")
 @pytest.mark.parametrize("method", SOA)
 def test_columns_of_bodies_across_blocks_match_single_runs_bit_for_bit(body, method):
     """More bodies than a block (the last one partial), spins up to 60 rad/s so that many

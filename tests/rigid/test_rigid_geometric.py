@@ -190,6 +190,7 @@ def test_trajectory_reports_kinetic_potential_and_total_energy():
     assert np.ptp(run.kinetic_energy) > 1e3 * np.ptp(run.energy)  # exchanged, total kept
 
 
+@pytest.mark.filterwarnings("ignore:h=.* turns the body:UserWarning")
 @pytest.mark.parametrize(
     "method, h, omega0",
     [("midpoint-lp", 10.0, (1.0, 1.0, 1.0)), ("dmv", 3.0, (20.0, 0.0, 40.0))],

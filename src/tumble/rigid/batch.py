@@ -262,7 +262,10 @@ def _batch_size(bodies, one_body: bool, arrays: dict) -> tuple[int, str]:
         return len(bodies), f"{len(bodies)} bodies"
     for name, value in arrays.items():
         if value is not None:
-            shape = np.shape(value)
+            try:
+                shape = np.shape(value)
+            except ValueError:  # a ragged nesting
+                raise _checks.fail(name, value, "an array of one row per body") from None
             if len(shape) != 1 + len(_ROW_SHAPES[name]) or shape[0] == 0:
                 expected = ", ".join(["N", *map(str, _ROW_SHAPES[name])])
                 raise _checks.fail(
@@ -276,7 +279,7 @@ def _rows(value, name: str, n: int, source: str) -> np.ndarray | None:
     """``value`` as a finite float array of shape ``(n, *row)``, or None."""
     if value is None:
         return None
-    array = np.asarray(value, dtype=float)
+    array = _checks.array(name, value, finite=False)  # numbers; the rows' entries below
     expected = (n, *_ROW_SHAPES[name])
     if array.shape != expected:
         raise _checks.fail(
@@ -293,20 +296,23 @@ def _rows(value, name: str, n: int, source: str) -> np.ndarray | None:
 def _initial_states(bodies, R0, q0, omega0, L0, x0, v0, n: int):
     """``(R, Y)`` of shapes (N, 3, 3) and (N, 9), as :func:`initial.initial_state` per body."""
     if omega0 is not None and L0 is not None:
-        raise ValueError(
-            "give at most one of omega0 (body-frame angular velocity) and L0 (world angular "
-            "momentum); they describe the same thing"
-        )
+        raise _checks.fail(
+            "L0", "<array>", "None when omega0 is given",
+            remedy="give at most one of omega0 (body-frame angular velocity) and L0 (world "
+            "angular momentum); they describe the same thing",
+        )  # fmt: skip
     if R0 is not None and q0 is not None:
-        raise ValueError("give at most one of R0 and q0 (both describe the initial attitude)")
+        raise _checks.fail("q0", "<array>", "None when R0 is given",
+                           remedy="give at most one of R0 and q0 (both describe the initial "
+                           "attitude)")  # fmt: skip
     if q0 is not None:
-        norm = np.linalg.norm(q0, axis=-1)
-        if np.any(norm == 0):
-            index = int(np.argmin(norm))
+        zero = ~np.any(q0, axis=-1)
+        if np.any(zero):
+            index = int(np.argmax(zero))
             raise _checks.fail(
                 f"q0[{index}]", q0[index].tolist(), "a quaternion [w, x, y, z] of non-zero norm"
             )
-        R = so3.matrix_from_quat(q0 / norm[:, None])
+        R = so3.matrix_from_quat(q0)  # normalised there, without overflow in |q|²
     elif R0 is not None:
         R = so3.validate_rotation(R0, name="R0", atol=1e-9)
     else:
@@ -316,11 +322,13 @@ def _initial_states(bodies, R0, q0, omega0, L0, x0, v0, n: int):
     else:
         omega = np.zeros((n, 3)) if omega0 is None else omega0
         inertia = _per_body(bodies, lambda body: body.inertia)
-        L = (R @ (inertia @ omega[..., None]))[..., 0]
+        with np.errstate(over="ignore", invalid="ignore"):  # too large a spin: a status, later
+            L = (R @ (inertia @ omega[..., None]))[..., 0]
     mass = _per_body(bodies, lambda body: body.mass)[:, None]
     x = np.zeros((n, 3)) if x0 is None else x0
     v = np.zeros((n, 3)) if v0 is None else v0
-    return R, np.concatenate([x, mass * v, L], axis=1)
+    with np.errstate(over="ignore"):
+        return R, np.concatenate([x, mass * v, L], axis=1)
 
 
 def _kernel_loads(forces, bodies):
@@ -388,9 +396,9 @@ def simulate_batch(
         Start time (s).
     x0, v0 : array_like, shape (N, 3), optional
         Initial positions (m) and velocities (m/s); default 0.
-    R0 : array_like, shape (N, 3, 3), optional
-        Initial attitudes (rotation matrices), or
-    q0 : array_like, shape (N, 4), optional
+    R0 : array_like, shape (N, 3, 3), or scipy.spatial.transform.Rotation, optional
+        Initial attitudes (rotation matrices, or one scipy ``Rotation`` of ``N``), or
+    q0 : array_like, shape (N, 4), or scipy.spatial.transform.Rotation, optional
         as quaternions ``[w, x, y, z]``; default identity.
     omega0 : array_like, shape (N, 3), optional
         Initial body-frame angular velocities (rad/s), or
@@ -439,18 +447,22 @@ def simulate_batch(
         )  # fmt: skip
     t0, t_end = initial.check_times(t0, t_end)
     h, _, _ = initial.check_steps(spec, h, None, None)
-    every = _checks.count("record_every", record_every)
-    if list(events):
+    every = initial.check_record_every(record_every)
+    if _checks.callables("events", events):
         raise _checks.fail(
             "events", events, "empty", remedy="simulate_batch locates no events: use simulate"
         )
+    forces = _checks.items("forces", forces, "a sequence of constant loads")
     bodies, one_body = _bodies(body_or_bodies)
+    R0, q0 = so3.from_scipy(R0, "R0"), so3.from_scipy(q0, "q0", quaternion=True)  # N rotations
     arrays = {"omega0": omega0, "L0": L0, "R0": R0, "q0": q0, "x0": x0, "v0": v0}
     n_bodies, source = _batch_size(bodies, one_body, arrays)
     rows = {name: _rows(value, name, n_bodies, source) for name, value in arrays.items()}
     bodies = bodies * n_bodies if one_body else bodies
     R, Y = _initial_states(bodies, rows["R0"], rows["q0"], rows["omega0"], rows["L0"],
                            rows["x0"], rows["v0"], n_bodies)  # fmt: skip
+    inverses = _per_body(bodies, lambda body: body.inertia_inverse)
+    initial.warn_large_step(spec, h, t_end - t0, inverses, R, Y[:, 6:])
     check_free(spec, split_loads(forces)[0])
     loads = _kernel_loads(forces, bodies)
     settings = {"h": h, "rtol": None, "atol": None, "record_every": every, "compiled": True}

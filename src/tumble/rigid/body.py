@@ -2,13 +2,19 @@
 
 from __future__ import annotations
 
+import math
+import sys
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from tumble import _checks
 from tumble.mass import MassProperties, validate_inertia, validate_mass
+
+LARGEST = sys.float_info.max
+"""The largest double, 1.8e308."""
 
 
 @dataclass(frozen=True)
@@ -46,17 +52,30 @@ class RigidBody:
     inertia_inverse: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
-        inertia = np.asarray(self.inertia, dtype=float)
+        mass = validate_mass(self.mass)
+        if not math.isfinite(1.0 / mass):  # v = p/m: a subnormal mass makes every velocity inf
+            raise _checks.fail("mass", self.mass, f">= {1 / LARGEST:.3g} (1/mass finite)", "kg",
+                               remedy="give the body in other units")  # fmt: skip
+        unphysical = _checks.flag("allow_unphysical", self.allow_unphysical)
+        inertia = _checks.array("inertia", self.inertia, unit="kg m²")
         if inertia.shape == (3,):
             inertia = np.diag(inertia)
-        inertia = validate_inertia(
-            inertia, name="inertia", allow_unphysical=self.allow_unphysical
-        ).copy()
-        inverse = np.linalg.inv(inertia)
+        elif inertia.shape != (3, 3):
+            raise _checks.fail("inertia", self.inertia,
+                               "of shape (3, 3), or (3,) for the diagonal", "kg m²")  # fmt: skip
+        inertia = validate_inertia(inertia, name="inertia", allow_unphysical=unphysical).copy()
+        with np.errstate(over="ignore"):
+            inverse = np.linalg.inv(inertia)
+        if np.count_nonzero(np.isfinite(inverse)) != 9:  # ω = I⁻¹ L: subnormal moments
+            raise _checks.fail(
+                "inertia", inertia.tolist(), "principal moments whose inverses are finite",
+                "kg m²", remedy=f"I⁻¹ overflows past {LARGEST:.2g}; give the body in other units",
+            )  # fmt: skip
         inertia.setflags(write=False)
         inverse.setflags(write=False)
-        object.__setattr__(self, "mass", validate_mass(self.mass))
+        object.__setattr__(self, "mass", mass)
         object.__setattr__(self, "inertia", inertia)
+        object.__setattr__(self, "allow_unphysical", unphysical)
         object.__setattr__(self, "inertia_inverse", inverse)
 
     @classmethod

@@ -6,6 +6,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from tumble import _checks
 from tumble.rigid.body import RigidBody
 from tumble.rigid.forces import State
 
@@ -26,7 +27,8 @@ def flip_event(
     Parameters
     ----------
     body : RigidBody
-        The body (its principal axes).
+        The body (its principal axes): its three principal moments must differ (a sphere or
+        a symmetric top has no intermediate axis, and is refused).
     direction : {0, 1, -1}
         Every flip (0), or only those where ``g`` rises (+1) or falls (−1).
     terminal : bool or int
@@ -49,7 +51,16 @@ def flip_event(
     >>> np.round(flips, 4), bool(abs((flips[2] - flips[0]) / period - 1) < 1e-8)
     (array([11.8154, 35.4461, 59.0768]), True)
     """
+    if not isinstance(body, RigidBody):
+        raise _checks.fail("body", body, "a tumble.RigidBody")
+    if isinstance(direction, bool) or direction not in (-1, 0, 1):
+        raise _checks.fail("direction", direction, "-1, 0 or +1")
+    if not isinstance(terminal, bool | np.bool_) and not (
+        isinstance(terminal, int | np.integer) and terminal >= 1
+    ):
+        raise _checks.fail("terminal", terminal, "True, False or an integer k >= 1 (the k-th)")
     moments, axes = np.linalg.eigh(body.inertia)
+    _check_distinct(body, moments)
     middle = axes[:, 1].copy()
 
     def flip(t: float, state: State) -> float:
@@ -58,3 +69,23 @@ def flip_event(
     flip.direction = direction  # type: ignore[attr-defined]
     flip.terminal = terminal  # type: ignore[attr-defined]
     return flip
+
+
+DISTINCT_RTOL = 1e-9
+"""How far apart (relative to the largest) the principal moments must be for the middle axis
+to be one: closer, the axis is not defined to round-off."""
+
+
+def _check_distinct(body: RigidBody, moments: np.ndarray) -> None:
+    """Refuse a body whose middle principal moment equals another: it has no intermediate
+    axis. A sphere never flips (no event would ever fire), and on a symmetric top the
+    "middle" axis is any axis in the symmetric plane, chosen by round-off: its zeros would be
+    the precession's, not flips."""
+    gap = min(moments[1] - moments[0], moments[2] - moments[1])
+    if gap <= DISTINCT_RTOL * moments[2]:
+        raise _checks.fail(
+            "body", f"RigidBody(inertia with principal moments {moments.tolist()})",
+            "a body with three distinct principal moments (an intermediate axis)",
+            remedy="a flip is the turn-over of a spin near the middle axis; with two equal "
+            "moments there is none (a symmetric body precesses steadily)",
+        )  # fmt: skip

@@ -29,9 +29,18 @@ from tumble.rigid.forces import Force, Gravity, Impulse, MagneticDipole, Torque
 
 
 def pivot_body(body: RigidBody, pivot: np.ndarray) -> RigidBody:
-    """The body with its inertia about ``pivot`` (parallel-axis theorem)."""
-    shift = body.mass * (pivot @ pivot * np.eye(3) - np.outer(pivot, pivot))
-    return RigidBody(body.mass, body.inertia + shift, allow_unphysical=True)
+    """The body with its inertia about ``pivot`` (parallel-axis theorem); a pivot so far out
+    that ``m |r|²`` overflows is refused, naming it."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        shift = body.mass * (pivot @ pivot * np.eye(3) - np.outer(pivot, pivot))
+        inertia = body.inertia + shift
+    if np.count_nonzero(np.isfinite(inertia)) != 9:
+        raise _checks.fail(
+            "pivot", pivot.tolist(), "a point whose inertia about it is finite", "m",
+            remedy=f"m |r|² = {body.mass:.3g} kg × ({float(np.max(np.abs(pivot))):.3g} m)² "
+            "overflows past 1.8e308 kg m²; give the body in other units",
+        )  # fmt: skip
+    return RigidBody(body.mass, inertia, allow_unphysical=True)
 
 
 def pivot_forces(forces, mass: float, pivot: np.ndarray, x_pivot: np.ndarray) -> list:

@@ -217,11 +217,13 @@ def simulate(
     t0, t_end = initial.check_times(t0, t_end)
     h, rtol, given_atol = initial.check_steps(spec, h, rtol, atol)
     R, Y = initial.initial_state(body, x0, v0, R0, q0, omega0, L0)
-    record_every = _checks.count("record_every", record_every)
+    record_every = initial.check_record_every(record_every)
     progress = _checks.flag("progress", progress)
+    compiled = _checks.optional_flag("compiled", compiled, remedy=COMPILED_REMEDY)
     loads, impulses = _checked_loads(spec, forces, t0, t_end)
     events = _checks.callables("events", events, remedy="g(t, state) with state a State")
     dense_output = _checks.flag("dense_output", dense_output)
+    initial.warn_large_step(spec, h, t_end - t0, body.inertia_inverse, R, Y[6:])
     times = None if t_eval is None else _checks.sample_times("t_eval", t_eval, t0, t_end)
     control = _control(spec, body, Y, t_end - t0, rtol, given_atol)
     # The stepper, from the method's family: compiled where its loop runs these loads.
@@ -241,11 +243,17 @@ def simulate(
     return _trajectory(out, stepper, spec, body, loads, settings)
 
 
+COMPILED_REMEDY = "None runs the numba kernels where they apply (the default)"
+"""What ``compiled``'s message adds."""
+
+
 def _checked_loads(
     method: Method, forces, t0: float, t_end: float
 ) -> tuple[list[Load], list[Impulse]]:
     """``forces`` split into continuous loads and impulses (:func:`split_loads`), checked:
-    none continuous for the exact flow, every impulse within the run."""
+    a sequence (None: none), none continuous for the exact flow, every impulse within the
+    run."""
+    forces = _checks.items("forces", forces, "a sequence of loads and impulses")
     loads, impulses = split_loads(forces)
     check_free(method, loads)
     _check_impulse_times(forces, t0, t_end)
@@ -333,7 +341,9 @@ def _march(stepper: BodyStepper, state, t_span: tuple[float, float], *, h: float
     ):
         return march(
             stepper, t_span, state, h=h, control=control, jumps=jumps,
-            events=[stepper.event(event) for event in events], record_every=record_every,
+            events=[stepper.event(initial.finite_event(event, index))
+                    for index, event in enumerate(events)],
+            record_every=record_every,
             progress=(lambda t: update(completed=t - t0)) if progress else None,
             t_eval=t_eval, dense_output=dense_output,
         )  # fmt: skip

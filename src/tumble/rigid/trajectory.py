@@ -9,11 +9,35 @@ from typing import Any
 
 import numpy as np
 
-from tumble import so3
+from tumble import _checks, so3
 from tumble.ode.dense import DenseOutput
 from tumble.ode.driver import Status
 from tumble.rigid.body import RigidBody
 from tumble.rigid.forces import State
+
+
+class NoSolution:
+    """``Trajectory.sol`` of a run without dense output: calling it says how to get one.
+
+    It is falsy, so ``if run.sol:`` tells the two apart.
+    """
+
+    def __call__(self, t: object) -> State:
+        raise _checks.fail(
+            "dense_output", False, "True for Trajectory.sol(t)",
+            remedy="simulate(..., dense_output=True) keeps every step's interpolant (Python "
+            "steps); t_eval=[...] records the state at given times instead",
+        )  # fmt: skip
+
+    def __bool__(self) -> bool:
+        return False
+
+    def __repr__(self) -> str:
+        return "NoSolution()"
+
+
+NO_SOLUTION = NoSolution()
+"""The one :class:`NoSolution`."""
 
 
 class Solution:
@@ -40,7 +64,10 @@ class Solution:
         self.stepper, self.dense = stepper, DenseOutput(ts, interpolants)
 
     def __call__(self, t: float | Sequence[float] | np.ndarray) -> State:
-        times, index = self.dense.steps(np.asarray(t, dtype=float))
+        times = _checks.array("t", t, unit="s")  # NaN would pick no step: refused
+        if times.size == 0:
+            raise _checks.fail("t", t, "a time or a non-empty array of times", "s")
+        times, index = self.dense.steps(times)
         states = [
             self.stepper.public(self.dense.interpolants[int(i)](float(s)))
             for i, s in zip(np.ravel(index), np.ravel(times), strict=True)
@@ -85,8 +112,10 @@ class Trajectory:
     potential_energy : ndarray, shape (n,), optional
         ``V`` of the loads that derive from a potential (gravity, constant forces, magnetic
         dipoles), J; zeros without such loads (``None`` given: zeros).
-    sol : Solution, optional
-        The continuous solution, ``sol(t)``, with ``simulate(..., dense_output=True)``.
+    sol : Solution or NoSolution
+        The continuous solution, ``sol(t)``, with ``simulate(..., dense_output=True)``;
+        otherwise a falsy :class:`NoSolution` whose call raises a ValueError naming that
+        remedy.
 
     Notes
     -----
@@ -114,11 +143,13 @@ class Trajectory:
     t_events: list = field(default_factory=list)
     q_raw: np.ndarray | None = None
     potential_energy: np.ndarray = None  # type: ignore[assignment]
-    sol: Solution | None = field(default=None, repr=False, compare=False)
+    sol: Solution | NoSolution | None = field(default=None, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.potential_energy is None:
             self.potential_energy = np.zeros(len(self.t))
+        if self.sol is None:
+            self.sol = NO_SOLUTION
 
     @property
     def success(self) -> bool:

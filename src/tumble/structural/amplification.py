@@ -40,7 +40,7 @@ from numpy.typing import ArrayLike, NDArray
 from tumble import _checks
 from tumble.structural.scheme import Scheme
 from tumble.structural.schemes import resolve_scheme
-from tumble.structural.system import LinearSystem
+from tumble.structural.system import LinearSystem, checked_system
 
 
 @dataclass(frozen=True, eq=False)
@@ -102,11 +102,23 @@ def amplification(scheme: str | Scheme, omega: ArrayLike, xi: float = 0.0) -> Am
     2.0
     """
     scheme = resolve_scheme(scheme)
-    omega = np.atleast_1d(_checks.array("omega", omega, unit="rad", positive=True))
+    given, omega = omega, np.atleast_1d(_checks.array("omega", omega, unit="rad", positive=True))
+    if omega.ndim != 1 or omega.size == 0:
+        raise _checks.fail("omega", given, "a number or a 1-D array of them (at least one), "
+                           "each finite and > 0", "rad")  # fmt: skip
     xi = _checks.non_negative("xi", xi)
     if not xi < 1:
         raise _checks.fail("xi", xi, "in [0, 1): an underdamped oscillator")
-    G = np.array([scheme.amplification_matrix(float(w), xi) for w in omega])
+    with np.errstate(over="ignore", invalid="ignore"):
+        G = np.array([scheme.amplification_matrix(float(w), xi) for w in omega])
+    finite = np.isfinite(G).reshape(len(G), -1).all(axis=1)
+    if not finite.all():  # Ω² past 1.8e308 (Ω ~ 1e154): LAPACK refuses the inf
+        index = int(np.argmin(finite))
+        raise _checks.fail(
+            f"omega[{index}]", float(omega[index]), "a value whose amplification matrix is "
+            "finite", "rad", remedy="Ω² overflows; as Ω → ∞ the spectral radius tends to the "
+            "scheme's ρ∞ (e.g. 1e6 shows it)",
+        )  # fmt: skip
     eigenvalues = np.linalg.eigvals(G)
     radius = np.abs(eigenvalues).max(axis=1)
     principal = np.take_along_axis(eigenvalues, np.argmax(eigenvalues.imag, axis=1)[:, None], 1)
@@ -174,10 +186,22 @@ def mode_table(
     """
     from tumble.structural.schemes import SCHEMES
 
+    system = checked_system(system)
     dt = _checks.positive("dt", dt, "s")
-    n = system.n_dofs if n_modes is None else _checks.count("n_modes", n_modes)
+    n = system.n_dofs if n_modes is None else _checks.count("n_modes", n_modes, 1, system.n_dofs)
+    if schemes is None:
+        chosen = tuple(SCHEMES.values())
+    else:
+        listed = _checks.items("schemes", schemes, "a sequence of scheme names or objects")
+        if not listed:
+            raise _checks.fail("schemes", schemes, "at least one scheme, or None for all")
+        chosen = tuple(resolve_scheme(s, f"schemes[{i}]") for i, s in enumerate(listed))
     omega = system.natural_frequencies(n)
-    chosen = tuple(resolve_scheme(s) for s in (SCHEMES.values() if schemes is None else schemes))
+    with np.errstate(over="ignore"):
+        phase = omega[-1] * dt
+    if not np.isfinite(phase):
+        raise _checks.fail("dt", dt, f"a step with ω_max dt finite (ω_max = {omega[-1]:.3g} "
+                           "rad/s)", "s")  # fmt: skip
     analyses = [amplification(s, omega * dt) for s in chosen]
     return ModeTable(
         dt,

@@ -23,6 +23,7 @@ References
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Mapping, Sequence
 
@@ -121,6 +122,9 @@ def build_frame(
         )
     }
     length, cos, sin = elements.element_geometry(nodes, connectivity)
+    _check_scales(section, length)
+    supports = _checks.instance("supports", supports, Mapping, "a mapping of node index to a "
+                                "support (e.g. {0: 'clamped'})")  # fmt: skip
     fixed = _fixed_dofs(supports, n_nodes)
     free = np.flatnonzero(~fixed.ravel())
     position = np.full(fixed.size, -1, dtype=np.int64)
@@ -197,27 +201,97 @@ def cantilever(
     (40, 1.0)
     """
     length = _checks.positive("length", length, "m")
-    n_elements = _checks.count("n_elements", n_elements)
+    n_elements = _checks.count("n_elements", n_elements, 1, max_elements(),
+                               remedy="the model would not fit in half the memory")  # fmt: skip
     width = _checks.positive("width", width, "m")
     height = _checks.positive("height", height, "m")
     tip_load = _checks.finite("tip_load", tip_load, "N")
+    sizes = {"length": (length, "m"), "E": (_checks.positive("E", E, "Pa"), "Pa"),
+             "rho": (_checks.positive("rho", rho, "kg/m³"), "kg/m³"), "width": (width, "m"),
+             "height": (height, "m")}  # fmt: skip
+    area, second_moment = _representable(sizes, lambda: _section_of(width, height))
+    ell = length / n_elements
+    _representable(sizes, lambda: _element_scales(ell, E, rho, area, second_moment))
     x = np.linspace(0.0, length, n_elements + 1)
     nodes = np.column_stack([x, np.zeros_like(x)])
     connectivity = np.column_stack([np.arange(n_elements), np.arange(1, n_elements + 1)])
     supports: dict[int, str | Sequence[bool]] = {0: "clamped"}
-    if not axial:
+    if not _checks.flag("axial", axial):
         supports |= {node: (True, False, False) for node in range(1, n_elements + 1)}
     return build_frame(
         nodes,
         connectivity,
         E=E,
         rho=rho,
-        area=width * height,
-        second_moment=width * height**3 / 12,
+        area=area,
+        second_moment=second_moment,
         supports=supports,
         loads={n_elements: (0.0, tip_load, 0.0)},
         monitor=(n_elements, 1),
     )
+
+
+ELEMENT_BYTES = 4096
+"""About what one element takes while a cantilever is assembled and stepped (its element
+matrices, the sparse matrices' entries, the factors and the workspaces; the peak resident
+memory measured 2.1 kB an element to build 2·10⁴ and 10⁵ elements, and 2.1–4.1 kB with two
+steps of ``integrate``): :func:`max_elements` divides half the memory by it."""
+
+
+def max_elements() -> int:
+    """The most elements a cantilever may have: what fits in half this machine's memory."""
+    return int(0.5 * _checks.memory() / ELEMENT_BYTES)
+
+
+def _section_of(width: float, height: float) -> tuple[float, ...]:
+    """``(A, I) = (w h, w h³/12)`` of a rectangular section."""
+    return width * height, width * height**3 / 12
+
+
+def _element_scales(ell, E, rho, area, second_moment) -> tuple[float, ...]:
+    """The sizes every entry of an element's matrices and the frequencies are made of: the
+    bar's ``EA/ℓ``, the beam's ``12 EI/ℓ³``, the mass ``ρAℓ`` and ``ω² ~ EI/(ρA ℓ⁴)``."""
+    EA, EI, mass = E * area, E * second_moment, rho * area * ell
+    return EA / ell, 12 * EI / ell**3, EI / ell, mass, mass * ell * ell, EI / (rho * area * ell**4)
+
+
+SECTION_UNITS = {"E": "Pa", "rho": "kg/m³", "area": "m²", "second_moment": "m⁴"}
+"""The units of :func:`build_frame`'s section properties."""
+
+
+def _check_scales(section: Mapping[str, NDArray], length: NDArray) -> None:
+    """:func:`_representable` for a frame: each property by its value furthest from 1."""
+
+    def extreme(values: NDArray) -> float:
+        with np.errstate(divide="ignore"):
+            return float(values[np.argmax(np.abs(np.log10(values)))])
+
+    sizes = {name: (extreme(section[name]), SECTION_UNITS[name]) for name in section}
+    sizes["nodes"] = (extreme(length), "m")
+    E, rho, area, second_moment = (section[name] for name in SECTION_UNITS)
+    _representable(sizes, lambda: _element_scales(length, E, rho, area, second_moment))
+
+
+def _representable(sizes: Mapping[str, tuple[float, str]], compute) -> tuple:
+    """``compute()``'s quantities, each refused unless a normal float (finite, and not so
+    small that it has lost digits or its inverse overflows): the ValueError names the
+    argument of ``sizes`` furthest from 1 (by orders of magnitude), with the others."""
+    tiny = np.finfo(float).tiny  # 2.2e-308
+    try:
+        with np.errstate(all="ignore"):
+            values = compute()
+    except (OverflowError, ZeroDivisionError):  # a float ** past 1.8e308, or / 0.0
+        values = (math.inf,)
+    if all(np.all((tiny <= np.abs(v)) & (np.abs(v) < math.inf)) for v in values):
+        return values
+    name = max(sizes, key=lambda key: abs(math.log10(sizes[key][0])))
+    others = ", ".join(f"{key}={value!r} {unit}" for key, (value, unit) in sizes.items()
+                       if key != name)  # fmt: skip
+    raise _checks.fail(
+        name, sizes[name][0], "such that the section, the stiffness, the mass and the "
+        "frequencies are normal floats (between 2.2e-308 and 1.8e308)", sizes[name][1],
+        remedy=f"with {others} they are not; give the beam in other units",
+    )  # fmt: skip
 
 
 def condition_estimate(S: sp.spmatrix) -> float:
@@ -232,18 +306,35 @@ def condition_estimate(S: sp.spmatrix) -> float:
     >>> f"{condition_estimate(beam.S):.1e}"   # grows like N⁴
     '2.3e+09'
     """
+    if not sp.issparse(S) or S.ndim != 2 or S.shape[0] != S.shape[1] or S.shape[0] == 0:
+        raise _checks.fail("S", S, "a square scipy.sparse matrix (LinearSystem.S)")
+    try:
+        return _estimate(S)
+    except RuntimeError:  # SuperLU: "Factor is exactly singular"
+        raise _checks.fail("S", S, "a nonsingular matrix", remedy="its LU factor is exactly "
+                           "singular: κ = inf") from None  # fmt: skip
+    except ValueError as error:
+        raise _checks.fail("S", S, "a matrix with finite entries, not all zero",
+                           remedy=str(error)) from None  # fmt: skip
+
+
+def _estimate(S: sp.spmatrix) -> float:
+    """:func:`condition_estimate`; a RuntimeError from SuperLU for a singular ``S``."""
     lam_max = float(abs(S).sum(axis=1).max())
+    if not 0 < lam_max < math.inf:
+        raise ValueError(f"the largest row sum of |S| is {lam_max:g}")
+    S = S / lam_max  # κ is scale-free; at scale 1 no norm below underflows
     solve = factorize(S)
     v = np.random.default_rng(0).standard_normal(S.shape[0])
     for _ in range(INVERSE_ITERATIONS):
         v = solve(v / np.linalg.norm(v))
     lam_min = 1.0 / float(np.linalg.norm(v))
-    return lam_max / lam_min
+    return float(abs(S).sum(axis=1).max()) / lam_min
 
 
 def _warn_if_ill_conditioned(S: sp.spmatrix, supports: Mapping) -> None:
     try:
-        kappa = condition_estimate(S)
+        kappa = _estimate(S)
     except RuntimeError as error:  # SuperLU: "Factor is exactly singular"
         raise _checks.fail(
             "supports",
@@ -346,6 +437,9 @@ def _fixed_dofs(supports: Mapping[int, str | Sequence[bool]], n_nodes: int) -> N
 
 def _nodal_loads(loads: Mapping[int, Sequence[float]] | None, n_nodes: int) -> NDArray:
     f = np.zeros((n_nodes, 3))
+    if loads is not None:
+        _checks.instance("loads", loads, Mapping, "None or a mapping of node index to "
+                         "(F_x, F_y, M_z)")  # fmt: skip
     for node, load in (loads or {}).items():
         _check_node("loads", node, n_nodes)
         f[node] += _checks.array(
@@ -359,6 +453,9 @@ def _monitor_dof(
 ) -> int:
     if monitor is None:
         return int(np.argmax(np.abs(f))) if np.any(f) else f.size - 1
+    if not isinstance(monitor, tuple | list) or len(monitor) != 2:
+        raise _checks.fail("monitor", monitor, "None or a pair (node, component 0|1|2 for "
+                           "u|v|θ)")  # fmt: skip
     node, component = monitor
     _check_node("monitor", node, n_nodes)
     index = position[3 * node + component] if component in (0, 1, 2) else -1

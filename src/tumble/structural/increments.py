@@ -247,6 +247,16 @@ class ThetaScheme(IncrementScheme):
     theta_y: float
     seed_name: str
 
+    def __post_init__(self) -> None:
+        for name in ("name", "seed_name"):
+            if not isinstance(getattr(self, name), str) or not getattr(self, name):
+                raise _checks.fail(name, getattr(self, name), "a non-empty str")
+        for name in ("theta_x", "theta_y"):
+            theta = _checks.finite(name, getattr(self, name))
+            if not 0 <= theta <= 1:
+                raise _checks.fail(name, getattr(self, name), "in [0, 1]: the weight of the new "
+                                   "value (0 old, 1 new, 1/2 midpoint)")  # fmt: skip
+
     @property
     def order(self) -> int:
         """Order of accuracy: 2 for θ_x = θ_y = ½ (midpoint), else 1."""

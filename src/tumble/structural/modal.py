@@ -41,7 +41,13 @@ from numpy.typing import ArrayLike, NDArray
 from tumble import _checks
 from tumble.ode.driver import Status
 from tumble.structural.schemes import Response
-from tumble.structural.system import LinearSystem, RayleighDamping
+from tumble.structural.system import (
+    LinearSystem,
+    RayleighDamping,
+    checked_damping,
+    checked_system,
+    dof_values,
+)
 
 EXACT_DOF_LIMIT = 4000
 """Largest system :func:`exact_response` takes (a dense SVD of this size takes ~1 min)."""
@@ -200,10 +206,20 @@ def exact_response(
     >>> round(float(late.tip_displacement[0] * 3 * 175.0), 12)
     1.0
     """
+    system = checked_system(system)
+    damping = checked_damping(damping)
     times = np.atleast_1d(_checks.array("t", t, unit="s"))
     if times.ndim != 1 or np.any(times < 0):
         raise _checks.fail("t", t, "a 1-D array of finite times >= 0", "s")
-    x, y = ModalSolution.from_system(system, x0, y0, damping).state(times)
+    solution = ModalSolution.from_system(system, x0, y0, damping)
+    with np.errstate(over="ignore"):
+        phase = solution.omega[-1] * times.max() if times.size else 0.0
+    if not np.isfinite(phase):
+        raise _checks.fail(
+            "t", t, f"times with ω_max t finite (ω_max = {solution.omega[-1]:.3g} rad/s)", "s",
+            remedy="past that the phase ω t overflows and sin(ω t) has no digit",
+        )  # fmt: skip
+    x, y = solution.state(times)
     energy = system.energy(x, y)
     message = "the exact response by modal superposition"
     return Response(times, x, y, energy, "exact", 0.0, system.tip_dof, Status.SUCCESS, message,
@@ -225,9 +241,10 @@ def modal_energies(system: LinearSystem, x: ArrayLike, y: ArrayLike) -> NDArray[
     >>> bool(np.isclose(energies.sum(), 0.5 / (3 * 175.0)))   # ½ F δ_static
     True
     """
+    system = checked_system(system)
+    x, y = dof_values(system, "x", x), dof_values(system, "y", y)
     omega, shapes = system.modes(system.n_dofs)
     static = shapes @ ((shapes.T @ system.f) / omega**2)
-    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     u = (x - static) @ (system.M @ shapes)
     du = y @ (system.M @ shapes)
     return 0.5 * (du**2 + (omega * u) ** 2)

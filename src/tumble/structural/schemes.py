@@ -62,7 +62,12 @@ from tumble.structural.stepping import (
     Watched,
     initial_state,
 )
-from tumble.structural.system import LinearSystem, RayleighDamping
+from tumble.structural.system import (
+    LinearSystem,
+    RayleighDamping,
+    checked_damping,
+    checked_system,
+)
 from tumble.structural.wilson import WilsonTheta
 
 PROGRESS_UPDATES = 200
@@ -150,11 +155,13 @@ class Response:
         return self.status.success
 
 
-def resolve_scheme(scheme: str | Scheme) -> Scheme:
-    """A scheme object from its name (one of :data:`SCHEMES`) or the object itself."""
+def resolve_scheme(scheme: str | Scheme, name: str = "scheme") -> Scheme:
+    """A scheme object from its name (one of :data:`SCHEMES`) or the object itself; the
+    ValueError for anything else names ``name``."""
     if isinstance(scheme, Scheme):
         return scheme
-    return SCHEMES[_checks.choice("scheme", scheme, SCHEMES)]
+    example = "or a scheme object, e.g. tumble.structural.Newmark(beta=0.3025, gamma=0.6)"
+    return SCHEMES[_checks.choice(name, scheme, SCHEMES, remedy=example)]
 
 
 def integrate(
@@ -229,11 +236,16 @@ def integrate(
     >>> run.solver
     'banded-cholesky'
     """
+    system = checked_system(system)
     scheme = resolve_scheme(scheme)
     dt = _checks.positive("dt", dt, "s")
     n_steps = _step_count(n_steps, t_end, dt)
-    record_every = _checks.count("record_every", record_every)
+    record_every = min(_checks.count("record_every", record_every), MAX_STEPS)
+    progress = _checks.flag("progress", progress)
+    compiled = _checks.optional_flag("compiled", compiled)
+    _check_record_size(system, n_steps, record_every)
     state = _initial_state(system, x0, y0)
+    damping = checked_damping(damping)
     C = None if damping is None else damping.matrix(system)
     block = min(
         max(1, n_steps // PROGRESS_UPDATES) if progress else n_steps,
@@ -275,7 +287,15 @@ def _choose_stepper(
 ) -> tuple[Watched, str]:
     """The compiled stepper with banded Cholesky factors of the step matrices, or the
     reference stepper with SuperLU; and the solver's name."""
-    matrices = scheme.matrices(system, C, dt)
+    with np.errstate(over="ignore", invalid="ignore"):
+        matrices = scheme.matrices(system, C, dt)
+    for A in matrices:  # dt² S past 1.8e308: LAPACK, SuperLU would refuse it in their words
+        if np.count_nonzero(np.isfinite(A.data)) != A.data.size:
+            raise _checks.fail(
+                "dt", dt, "a step whose step matrices are finite", "s",
+                remedy=f"the {scheme.name} step's matrix (M, C dt and S dt² combined) overflows "
+                "past 1.8e308; take a smaller dt",
+            )  # fmt: skip
     factors = _banded_factors(matrices, compiled)
     if factors is None:
         return ReferenceBeamStepper(system, scheme, C, dt, matrices), "sparse-lu"
@@ -312,9 +332,32 @@ def _step_count(n_steps: int | None, t_end: float | None, dt: float) -> int:
     if n_steps is not None and t_end is not None:
         raise _checks.fail("t_end", t_end, "None when n_steps is given", remedy=one)
     if n_steps is not None:
-        return _checks.count("n_steps", n_steps)
+        return _checks.count("n_steps", n_steps, 1, MAX_STEPS, remedy="a run this long never ends")
     t_end = _checks.positive("t_end", t_end, "s")
-    return max(1, math.ceil(t_end / dt * (1 - 1e-12)))
+    steps = t_end / dt * (1 - 1e-12)
+    if not steps <= MAX_STEPS:
+        raise _checks.fail("t_end", t_end, f"at most {MAX_STEPS:.3g} steps of dt={dt!r} s", "s",
+                           remedy=f"that is {steps:.3g} steps, a run that never ends")  # fmt: skip
+    return max(1, math.ceil(steps))
+
+
+MAX_STEPS = 2**62
+"""The most steps (and the largest ``record_every``) :func:`integrate` takes: the compiled
+loop counts them in int64 (at 10 ns a step, 1500 years)."""
+
+
+def _check_record_size(system: LinearSystem, n_steps: int, record_every: int) -> None:
+    """Refuse, before any work, a run whose records would not fit in half the memory."""
+    records = n_steps // record_every + 2
+    need = records * (2 * system.n_dofs + 2) * 8.0
+    allowed = 0.5 * _checks.memory()
+    if need > allowed:
+        every = math.ceil(n_steps * (2 * system.n_dofs + 2) * 8.0 / allowed)
+        raise _checks.fail(
+            "n_steps", n_steps, f"a run whose {records:.3g} records fit in half the memory "
+            f"({allowed / 2**30:.3g} GiB; they need {need / 2**30:.3g} GiB)",
+            remedy=f"record fewer with record_every >= {every}, or take fewer steps",
+        )  # fmt: skip
 
 
 def _initial_state(system: LinearSystem, x0: ArrayLike | None, y0: ArrayLike | None) -> BeamState:

@@ -27,8 +27,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from tumble import _checks
 from tumble.structural.scheme import Scheme
-from tumble.structural.schemes import integrate, resolve_scheme
-from tumble.structural.system import DENSE_EIGEN_LIMIT, LinearSystem
+from tumble.structural.schemes import MAX_STEPS, integrate, resolve_scheme
+from tumble.structural.system import DENSE_EIGEN_LIMIT, LinearSystem, checked_system
 
 STABLE_GROWTH = 1.0
 """A run counts as stable if its energy never rose above the start by this many scales."""
@@ -95,6 +95,7 @@ def critical_dt(system: LinearSystem, scheme: str | Scheme) -> CriticalStep:
     >>> f"{step.dt:.3e} s", step.mode, critical_dt(beam, "midpoint").dt
     ('5.593e-06 s', 'bending', inf)
     """
+    system = checked_system(system)
     scheme = resolve_scheme(scheme)
     z_max = scheme.critical_omega()
     if z_max == 0.0 or math.isinf(z_max):
@@ -137,11 +138,20 @@ def energy_scale(
     >>> round(energy_scale(beam) / (0.5 * 1.0 / (3 * 175.0)), 9)   # ½ F · F L³/(3EI)
     1.0
     """
+    system = checked_system(system)
     scale = 0.5 * float(system.f @ system.static_displacement())
-    if x0 is not None:
-        scale += float(system.strain_energy(x0))
-    if y0 is not None:
-        scale += float(system.kinetic_energy(y0))
+    shape = (system.n_dofs,)
+    x0 = None if x0 is None else _checks.array("x0", x0, shape=shape, unit="m, rad")
+    y0 = None if y0 is None else _checks.array("y0", y0, shape=shape, unit="m/s, rad/s")
+    with np.errstate(over="ignore", invalid="ignore"):  # refused below, by name
+        if x0 is not None:
+            scale += float(system.strain_energy(x0))
+        if y0 is not None:
+            scale += float(system.kinetic_energy(y0))
+    if not np.isfinite(scale):
+        raise _checks.fail("x0" if x0 is not None else "system", "<the initial state>",
+                           "a state whose energy is finite", "J",
+                           remedy="½ xᵀ S x + ½ yᵀ M y overflows past 1.8e308")  # fmt: skip
     if not scale > 0:
         raise _checks.fail(
             "x0",
@@ -206,9 +216,13 @@ def stability_sweep(
     >>> sweep.stable.tolist()
     [True, False]
     """
+    system = checked_system(system)
     scheme = resolve_scheme(scheme)
-    dts = np.atleast_1d(_checks.array("dts", dts, unit="s", positive=True))
-    n_steps = _checks.count("n_steps", n_steps)
+    given, dts = dts, np.atleast_1d(_checks.array("dts", dts, unit="s", positive=True))
+    if dts.ndim != 1 or dts.size == 0:
+        raise _checks.fail("dts", given, "a step or a 1-D array of them (at least one), each "
+                           "finite and > 0", "s")  # fmt: skip
+    n_steps = _checks.count("n_steps", n_steps, 1, MAX_STEPS, remedy="a run this long never ends")
     scale = energy_scale(system, x0, y0)
     record_every = max(1, n_steps // MAX_SWEEP_RECORDS)
     growth = np.empty(dts.size)

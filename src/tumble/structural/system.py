@@ -146,11 +146,7 @@ class LinearSystem:
                [0., 1., 2.],
                [0., 3., 4.]])
         """
-        x = np.asarray(x, dtype=float)
-        if x.shape[-1:] != (self.n_dofs,):
-            raise _checks.fail(
-                "x", x, f"of shape (..., {self.n_dofs})", "m, rad", f"it has shape {x.shape}"
-            )
+        x = dof_values(self, "x", x)
         full = np.zeros(x.shape[:-1] + (self.n_all_dofs,))
         full[..., self.free] = x
         return full
@@ -287,7 +283,7 @@ class LinearSystem:
 
     def strain_energy(self, x: ArrayLike) -> NDArray:
         """``½ xᵀ S x`` [J] from element natural deformations, shape ``x.shape[:-1]``."""
-        return self.elements.strain_energy(x).sum(axis=(-2, -1))
+        return self.elements.strain_energy(dof_values(self, "x", x)).sum(axis=(-2, -1))
 
     def energy(self, x: ArrayLike, y: ArrayLike) -> NDArray:
         """Total energy ``E = ½ yᵀ M y + ½ xᵀ S x − fᵀ x`` [J], shape ``x.shape[:-1]``.
@@ -295,12 +291,12 @@ class LinearSystem:
         Kinetic plus strain energy plus the potential of the constant loads; constant in
         time for the exact motion without damping (seed 003).
         """
-        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        x, y = dof_values(self, "x", x), dof_values(self, "y", y)
         return self.kinetic_energy(y) + self.strain_energy(x) - x @ self.f
 
     def kinetic_energy(self, y: ArrayLike) -> NDArray:
         """``½ yᵀ M y`` [J] for velocities ``y`` of shape (..., n_dofs)."""
-        y = np.asarray(y, dtype=float)
+        y = dof_values(self, "y", y)
         rows = y.reshape(-1, self.n_dofs)
         return 0.5 * np.sum(rows * (self.M @ rows.T).T, axis=1).reshape(y.shape[:-1])
 
@@ -344,3 +340,27 @@ class RayleighDamping:
     def matrix(self, system: LinearSystem) -> sp.csr_matrix:
         """``C = α M + β S`` [N s/m, ...], shape (n_dofs, n_dofs)."""
         return (self.mass_coefficient * system.M + self.stiffness_coefficient * system.S).tocsr()
+
+
+def checked_system(system: object, name: str = "system") -> LinearSystem:
+    """``system`` if it is a :class:`LinearSystem`, else the ValueError naming ``name``."""
+    return _checks.instance(
+        name, system, LinearSystem, "a tumble.structural.LinearSystem",
+        remedy="build one with tumble.structural.cantilever or build_frame",
+    )  # fmt: skip
+
+
+def checked_damping(damping: object) -> RayleighDamping | None:
+    """``damping`` if it is None or a :class:`RayleighDamping`, else the ValueError."""
+    if damping is None:
+        return None
+    return _checks.instance(
+        "damping", damping, RayleighDamping, "None or a tumble.structural.RayleighDamping",
+        remedy="e.g. RayleighDamping.from_damping_ratio(0.02, omega_1, omega_2)",
+    )  # fmt: skip
+
+
+def dof_values(system: LinearSystem, name: str, value: ArrayLike) -> NDArray:
+    """``value`` as a float array of shape (..., n_dofs): one value per free DOF (a leading
+    axis for records); its entries are not checked (NaN gives NaN)."""
+    return _checks.trailing(name, value, (system.n_dofs,), "values of the free DOFs")
