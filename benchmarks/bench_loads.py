@@ -49,13 +49,15 @@ def cases() -> dict[str, tuple[list, bool]]:
     return {
         "B-dot law, Python (+ GravityGradient)": ([GravityGradient(), Torque(law)], False),
         "B-dot law, numba.njit (+ GravityGradient)": (
-            [GravityGradient(), Torque(numba.njit(law))], False
+            [GravityGradient(), Torque(numba.njit(law))],
+            False,
         ),
         "user's dipole, Python": ([Torque(dipole_torque)], False),
         "user's dipole, numba.njit": ([Torque(numba.njit(dipole_torque))], False),
         "MagneticDipole, built-in": ([MagneticDipole(MOMENT, FIELD)], True),
         "MagneticDipole + GravityGradient, built-in": (
-            [MagneticDipole(MOMENT, FIELD), GravityGradient()], True
+            [MagneticDipole(MOMENT, FIELD), GravityGradient()],
+            True,
         ),
     }
 
@@ -98,8 +100,11 @@ def main(argv: list[str] | None = None) -> str:
     for row, name in zip(rows, per_step, strict=True):
         row.append(f"{per_step[name] / baseline:.0f}×")
     same = {
-        "B-dot": _difference(ends, "B-dot law, Python (+ GravityGradient)",
-                             "B-dot law, numba.njit (+ GravityGradient)"),  # fmt: skip
+        "B-dot": _difference(
+            ends,
+            "B-dot law, Python (+ GravityGradient)",
+            "B-dot law, numba.njit (+ GravityGradient)",
+        ),  # fmt: skip
         "dipole": _difference(ends, "user's dipole, Python", "user's dipole, numba.njit"),
     }
     dipole_ratio = per_step["user's dipole, numba.njit"] / per_step["MagneticDipole, built-in"]
@@ -107,8 +112,16 @@ def main(argv: list[str] | None = None) -> str:
         [
             "## Your own loads against the built-in ones (`benchmarks/bench_loads.py`)",
             "",
-            table(["the detumble cubesat, `rkmk4`, h = 1 s", "runs", "steps",
-                   "µs a step, median (min–max)", "× the built-ins' kernel"], rows),  # fmt: skip
+            table(
+                [
+                    "the detumble cubesat, `rkmk4`, h = 1 s",
+                    "runs",
+                    "steps",
+                    "µs a step, median (min–max)",
+                    "× the built-ins' kernel",
+                ],
+                rows,
+            ),  # fmt: skip
             "",
             f"The njit B-dot law's first call (numba compiling it): {compile_s:.2f} s. "
             f"The same numbers from both forms: the B-dot runs' states end "
