@@ -14,7 +14,7 @@ Rigid bodies
 :class:`RigidBody`                  mass and inertia about the centre of mass
 :func:`simulate`                    every rigid-body method through one entry point
 :class:`Gravity`, :class:`Force`    loads (also :class:`Torque`, :class:`MagneticDipole`,
-                                    :class:`Impulse`)
+                                    :class:`GravityGradient`, :class:`Impulse`)
 :class:`Trajectory`                 what ``simulate`` returns
 :func:`simulate_batch`              many bodies at once (compiled, parallel); a
                                     :class:`BatchTrajectory`
@@ -56,6 +56,7 @@ if TYPE_CHECKING:  # what static type checkers see; at run time __getattr__ impo
         BatchTrajectory,
         Force,
         Gravity,
+        GravityGradient,
         Impulse,
         MagneticDipole,
         RigidBody,
@@ -74,6 +75,7 @@ __all__ = [
     "ButcherTableau",
     "Force",
     "Gravity",
+    "GravityGradient",
     "Impulse",
     "MagneticDipole",
     "METHODS",
@@ -118,6 +120,7 @@ _NAMES = {
             "BatchTrajectory",
             "Force",
             "Gravity",
+            "GravityGradient",
             "Impulse",
             "MagneticDipole",
             "RigidBody",

@@ -19,6 +19,7 @@ SHORT = {
     "convergence": {"step_counts": [50, 100], "methods": ["rkmk4"]},
     "beam": {"n_elements": 8, "n_steps": 200, "sweep_steps": 100},
     "spinning-top": {"t_end": 0.5},
+    "detumble": {"threshold": 0.1, "h": 2.0, "record_every": 10},
 }
 RIGID = {"animation.gif", "view.html", "data.nc"}
 PROMISED = {
@@ -33,6 +34,7 @@ PROMISED = {
     "beam": {f"energy_{s}.png" for s in ("explicit", "semi-implicit", "implicit", "midpoint")}
     | {"stability_sweep.png", "beam_shapes.png", "animation.gif", "data.nc"},
     "spinning-top": {"top.png", "invariants.png"} | RIGID,
+    "detumble": {"detumble.png"} | RIGID,
 }  # fmt: skip
 
 

@@ -33,6 +33,7 @@ from tumble.rigid.forces import (
     Load,
     State,
     compiled_loads,
+    for_body,
     potential_energy,
     split_loads,
 )
@@ -406,7 +407,9 @@ def simulate_batch(
         world angular momenta (kg m²/s); default at rest.
     forces : sequence
         Constant loads, the same for every body: :class:`~tumble.Gravity` (``m g`` with each
-        body's mass), :class:`~tumble.Force` and :class:`~tumble.Torque` with constant vectors.
+        body's mass), :class:`~tumble.Force` and :class:`~tumble.Torque` with constant vectors,
+        :class:`~tumble.MagneticDipole`, :class:`~tumble.GravityGradient` (with each body's
+        inertia).
     events : sequence
         Not supported (must be empty): use :func:`~tumble.rigid.simulate`.
     record_every : int
@@ -465,9 +468,12 @@ def simulate_batch(
     initial.warn_large_step(spec, h, t_end - t0, inverses, R, Y[:, 6:])
     check_free(spec, split_loads(forces)[0])
     loads = _kernel_loads(forces, bodies)
+    # GravityGradient takes each body's inertia (broadcast over time, as the mass below)
+    inertias = _per_body(bodies, lambda body: body.inertia)[:, None]
+    conservative = [load for load in for_body(split_loads(forces)[0], inertias)
+                    if load.conservative]  # fmt: skip
     settings = {"h": h, "rtol": None, "atol": None, "record_every": every, "compiled": True}
     batch = _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings)
-    conservative = [load for load in split_loads(forces)[0] if load.conservative]
     if conservative:  # V for every body and sample at once (mass broadcast over time)
         masses = _per_body(batch.bodies, lambda body: body.mass)[:, None]
         batch.potential_energy = potential_energy(conservative, batch.x, batch.R, masses)
@@ -568,7 +574,8 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
         moments, axes = np.ones((len(bodies), 3)), np.tile(np.eye(3), (len(bodies), 1, 1))
         moments.setflags(write=False)
         axes.setflags(write=False)
-    stepper = BatchStepper(spec, problem(spec, inv_I, mass, loads, axes, moments))
+    inertia = _per_body(bodies, lambda body: body.inertia)
+    stepper = BatchStepper(spec, problem(spec, inv_I, mass, loads, axes, moments, inertia))
     out = march(stepper, (t0, t_end), stepper.start((R, Y)), h=h, record_every=every)
     names = ("R", "Y", "q") if family.quaternion else ("R", "Y")
     samples = dict(zip(names, out.records, strict=False))

@@ -25,7 +25,14 @@ import numpy as np
 
 from tumble import _checks
 from tumble.rigid.body import RigidBody
-from tumble.rigid.forces import Force, Gravity, Impulse, MagneticDipole, Torque
+from tumble.rigid.forces import (
+    Force,
+    Gravity,
+    GravityGradient,
+    Impulse,
+    MagneticDipole,
+    Torque,
+)
 
 
 def pivot_body(body: RigidBody, pivot: np.ndarray) -> RigidBody:
@@ -67,6 +74,12 @@ def pivot_forces(forces, mass: float, pivot: np.ndarray, x_pivot: np.ndarray) ->
                     remedy="give a constant torque, or simulate the free body",
                 )  # fmt: skip
             reduced.append(item)
+        elif isinstance(item, GravityGradient):
+            raise _checks.fail(
+                f"forces[{index}]", item, "a load other than GravityGradient with a pivot",
+                remedy="its expansion is about the centre of mass, not the pivot; simulate "
+                "the free body",
+            )  # fmt: skip
         elif isinstance(item, Impulse):
             reduced += [item, Impulse(x_pivot, -item.impulse, item.time)]
         else:

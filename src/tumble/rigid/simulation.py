@@ -21,6 +21,7 @@ from tumble.rigid.forces import (
     Load,
     State,
     compiled_loads,
+    for_body,
     potential_energy,
     split_loads,
 )
@@ -35,19 +36,23 @@ if TYPE_CHECKING:
 log = logging.getLogger(__name__)
 
 
-def problem(method: Method, inertia_inverse, mass, loads, axes, moments) -> KernelProblem:
+def problem(method: Method, inertia_inverse, mass, loads, axes, moments,
+            inertia=None) -> KernelProblem:  # fmt: skip
     """The kernels' :class:`~tumble.rigid._compiled.base.KernelProblem` for ``method`` and
     constant ``loads`` (:func:`~tumble.rigid.forces.compiled_loads`); ``axes``, ``moments`` are the
-    principal frame (``split`` methods; with a leading body axis in a batch)."""
+    principal frame (``split`` methods; with a leading body axis in a batch), ``inertia`` the
+    body's (the inverse of ``inertia_inverse`` when not given)."""
     from tumble.rigid._compiled.base import KernelProblem  # numba only for a compiled run
 
     if method.tableau is None:
         A, b = np.zeros((0, 0)), np.array(method.weights)
     else:
         A, b = method.tableau.A, method.tableau.b
-    F, tau, points, point_forces = loads
+    F, tau, points, point_forces, gravity = loads
+    if inertia is None:
+        inertia = np.linalg.inv(inertia_inverse)
     return KernelProblem(method.dexpinv, A, b, inertia_inverse, mass, F, tau, points, point_forces,
-                   axes, moments)  # fmt: skip
+                   axes, moments, gravity, np.asarray(inertia, dtype=float))  # fmt: skip
 
 
 def check_free(method: Method, loads) -> None:
@@ -69,7 +74,8 @@ def stepper_for(method: Method, body: RigidBody, loads, kernel_loads) -> BodySte
     if kernel_loads is None:
         return family.stepper(method, dynamics, None)
     moments, axes = family.frame(body.inertia)
-    kernel_problem = problem(method, body.inertia_inverse, body.mass, kernel_loads, axes, moments)
+    kernel_problem = problem(method, body.inertia_inverse, body.mass, kernel_loads, axes, moments,
+                             body.inertia)  # fmt: skip
     return family.stepper(method, dynamics, kernel_problem)
 
 
@@ -154,8 +160,9 @@ def simulate(
         (at most one; default at rest).
     forces : sequence
         :class:`~tumble.Gravity`, :class:`~tumble.Force`, :class:`~tumble.Torque`,
-        :class:`~tumble.MagneticDipole`, :class:`~tumble.Impulse` (a step lands on each
-        impulse's time, which must lie within the run).
+        :class:`~tumble.MagneticDipole`, :class:`~tumble.GravityGradient` (given the body's
+        inertia), :class:`~tumble.Impulse` (a step lands on each impulse's time, which must
+        lie within the run).
     events : sequence of callables
         ``g(t, state) -> float`` with ``terminal``/``direction`` as in :func:`tumble.solve`;
         ``state`` is a :class:`~tumble.rigid.forces.State` with ``x``, ``R``, ``p``, ``L``,
@@ -221,6 +228,7 @@ def simulate(
     progress = _checks.flag("progress", progress)
     compiled = _checks.optional_flag("compiled", compiled, remedy=COMPILED_REMEDY)
     loads, impulses = _checked_loads(spec, forces, t0, t_end)
+    loads = for_body(loads, body.inertia)
     events = _checks.callables("events", events, remedy="g(t, state) with state a State")
     dense_output = _checks.flag("dense_output", dense_output)
     initial.warn_large_step(spec, h, t_end - t0, body.inertia_inverse, R, Y[6:])

@@ -38,7 +38,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from tumble.rigid._compiled.base import _JIT, _cross, _quat_matrix, _rotate
+from tumble.rigid._compiled.base import _JIT, _cross, _gradient, _quat_matrix, _rotate
 from tumble.rigid._compiled.charts import (
     _SERIES2,
     _dexpinv_coefficient,
@@ -120,12 +120,12 @@ def _combine(stage, i, h, z, K, c, out):
 
 
 @njit(**_JIT)
-def _stage_state(stage, i, h, z, K, zs, off):
+def _stage_state(stage, i, h, z, K, zs, off, positions):
     """``zs = z + h Σ_{l<i} a_il K_l`` (:func:`_combine`, ``stage`` from :func:`_terms`) for
     the numbers the fields read: all but the positions ``x`` (rows ``off … off+2``), which
-    no field or load depends on."""
+    no field or load depends on but a point mass's gravity (``positions``)."""
     for c in range(z.shape[0]):
-        if c < off or c >= off + 3:
+        if positions or c < off or c >= off + 3:
             _combine(stage, i, h, z, K, c, zs)
 
 
@@ -174,6 +174,31 @@ def _point_loads(off, R, u, a, b, points, point_forces, K, i):
             s1 = R[3, j] * r0 + R[4, j] * r1 + R[5, j] * r2
             s2 = R[6, j] * r0 + R[7, j] * r1 + R[8, j] * r2
             t0, t1, t2 = _cross(s0, s1, s2, f0, f1, f2)
+            K[i, off + 3, j] += f0
+            K[i, off + 4, j] += f1
+            K[i, off + 5, j] += f2
+            K[i, off + 6, j] += t0
+            K[i, off + 7, j] += t1
+            K[i, off + 8, j] += t2
+
+
+@njit(**_JIT)
+def _gravity_loads(off, zs, R, u, a, b, m, inertia, gravity, K, i):
+    """The point masses' loads of :func:`~tumble.rigid._compiled.base._loads` for every body
+    (:func:`~tumble.rigid._compiled.base._gradient`, the same function: the same numbers);
+    ``R``, ``inertia`` (9, B) row-major, ``u`` (3, B), positions in rows ``off …`` of ``zs``.
+    A scalar loop (a call per body): the point masses are rare, their arithmetic long."""
+    for k in range(gravity.shape[0]):
+        mu, c0, c1, c2 = gravity[k, 0], gravity[k, 1], gravity[k, 2], gravity[k, 3]
+        for j in range(K.shape[2]):
+            Rt = (R[0, j], R[1, j], R[2, j], R[3, j], R[4, j], R[5, j], R[6, j], R[7, j],
+                  R[8, j])  # fmt: skip
+            It = (inertia[0, j], inertia[1, j], inertia[2, j], inertia[3, j], inertia[4, j],
+                  inertia[5, j], inertia[6, j], inertia[7, j], inertia[8, j])  # fmt: skip
+            f0, f1, f2, t0, t1, t2 = _gradient(
+                mu, m[j], zs[off, j] - c0, zs[off + 1, j] - c1, zs[off + 2, j] - c2, Rt, a[j],
+                b[j], u[0, j], u[1, j], u[2, j], It,
+            )  # fmt: skip
             K[i, off + 3, j] += f0
             K[i, off + 4, j] += f1
             K[i, off + 5, j] += f2
@@ -309,6 +334,9 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
     ``F``, contiguous) over the whole grid; the one-body loop's steps, body by body."""
     A, b, correct = problem.A, problem.b, problem.correct
     tau, points, point_forces = problem.tau, problem.points, problem.point_forces
+    gravity = problem.gravity
+    positions = gravity.shape[0] > 0
+    inertia = _columns(problem.inertia, j0, j0 + z.shape[1]) if positions else np.empty((9, 0))
     t_a, t_b, h, n_steps = grid
     s, (nz, n) = b.shape[0], z.shape
     off = 4 if quat else 3
@@ -323,16 +351,22 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
         if quat:
             _quat_start_soa(z)
         for i in range(s):
-            _stage_state(stage, i, hk, z, K, zs, off)
+            _stage_state(stage, i, hk, z, K, zs, off, positions)
             if quat:  # R(q/|q|) turns the points: no exp(û) (u = 0, a = b = 0)
                 _quat_field_soa(zs, R, inv_I, m, F, tau, K, i)
                 if points.shape[0]:
                     _point_loads(off, R, zero[0:3], zero[3], zero[3], points, point_forces, K, i)
+                if positions:
+                    _gravity_loads(off, zs, R, zero[0:3], zero[3], zero[3], m, inertia, gravity,
+                                   K, i)  # fmt: skip
             else:
                 _lie_field_soa(correct, zs, Rn, inv_I, m, F, tau, coefficients, K, i)
                 if points.shape[0]:
                     _point_loads(off, Rn, zs[0:3], coefficients[0], coefficients[1], points,
                                  point_forces, K, i)  # fmt: skip
+                if positions:
+                    _gravity_loads(off, zs, Rn, zs[0:3], coefficients[0], coefficients[1], m,
+                                   inertia, gravity, K, i)  # fmt: skip
         if _new_state(stage, hk, z, K, zn, bad):
             for j in range(n):
                 if not bad[j] == 0.0 and alive[j]:

@@ -22,6 +22,7 @@ _MODULES = {
     "beam": "tumble.scenarios.beam",
     "rigid-body": "tumble.scenarios.rigid_body",
     "spinning-top": "tumble.scenarios.spinning_top",
+    "detumble": "tumble.scenarios.detumble",
 }
 
 

@@ -48,7 +48,8 @@ def _quat_matrix(q0, q1, q2, q3, out):
 
 @njit(**_JIT)
 def _loads(off, zs, R, a, b, u0, u1, u2, problem, K, i):
-    """``K[i, off:] = (p/m, F + Σ f_k, τ + Σ (R exp(û) r_k) × f_k)``, ``zs[off:] = (x, p, L)``."""
+    """``K[i, off:] = (p/m, F + Σ f_k + Σ F_g, τ + Σ (R exp(û) r_k) × f_k + Σ τ_g)``,
+    ``zs[off:] = (x, p, L)``; ``(F_g, τ_g)`` the point masses' (:func:`_gradient`)."""
     m, F, tau = problem.m, problem.F, problem.tau
     points, point_forces = problem.points, problem.point_forces
     for c in range(3):
@@ -66,6 +67,65 @@ def _loads(off, zs, R, a, b, u0, u1, u2, problem, K, i):
         K[i, off + 6] += t0
         K[i, off + 7] += t1
         K[i, off + 8] += t2
+    gravity = problem.gravity
+    if gravity.shape[0] == 0:
+        return
+    I = problem.inertia
+    Rt = (R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2], R[2, 0], R[2, 1], R[2, 2])
+    It = (I[0, 0], I[0, 1], I[0, 2], I[1, 0], I[1, 1], I[1, 2], I[2, 0], I[2, 1], I[2, 2])
+    for k in range(gravity.shape[0]):
+        f0, f1, f2, t0, t1, t2 = _gradient(
+            gravity[k, 0], m, zs[off] - gravity[k, 1], zs[off + 1] - gravity[k, 2],
+            zs[off + 2] - gravity[k, 3], Rt, a, b, u0, u1, u2, It,
+        )  # fmt: skip
+        K[i, off + 3] += f0
+        K[i, off + 4] += f1
+        K[i, off + 5] += f2
+        K[i, off + 6] += t0
+        K[i, off + 7] += t1
+        K[i, off + 8] += t2
+
+
+@njit(**_JIT)
+def _gradient(mu, m, r0, r1, r2, R, a, b, u0, u1, u2, I):
+    """A :class:`~tumble.rigid.forces.GravityGradient`'s ``(F, τ)`` (world, six numbers):
+    the point mass ``μ`` seen at ``r = x − c`` by a body of mass ``m`` and inertia ``I``
+    (body axes, a 9-tuple row by row) at the attitude ``R exp(û)`` (``R`` a 9-tuple row by
+    row; ``a, b`` exp's coefficients of ``u``, zeros for the charts that carry no ``u``):
+
+    .. math:: \\tau = \\frac{3\\mu}{r^5} r \\times I_w r, \\quad
+              F = -\\frac{\\mu m}{r^3} r - \\frac{3\\mu}{r^5}\\Bigl[\\bigl(\\tfrac12
+              \\operatorname{tr} I - \\tfrac52 \\hat r^T I_w \\hat r\\bigr) r
+              + I_w r\\Bigr],
+
+    ``I_w r = R exp(û) I exp(−û) Rᵀ r``, the NumPy reference's formula term for term. One
+    function for the one-body loops and the batch's columns (:mod:`tumble.rigid.soa`), so
+    both do the same operations."""
+    s0 = R[0] * r0 + R[3] * r1 + R[6] * r2
+    s1 = R[1] * r0 + R[4] * r1 + R[7] * r2
+    s2 = R[2] * r0 + R[5] * r1 + R[8] * r2
+    s0, s1, s2 = _rotate(-a, b, u0, u1, u2, s0, s1, s2)  # r in body axes
+    y0 = I[0] * s0 + I[1] * s1 + I[2] * s2
+    y1 = I[3] * s0 + I[4] * s1 + I[5] * s2
+    y2 = I[6] * s0 + I[7] * s1 + I[8] * s2
+    v0, v1, v2 = _rotate(a, b, u0, u1, u2, y0, y1, y2)
+    w0 = R[0] * v0 + R[1] * v1 + R[2] * v2  # I_w r
+    w1 = R[3] * v0 + R[4] * v1 + R[5] * v2
+    w2 = R[6] * v0 + R[7] * v1 + R[8] * v2
+    rr = r0 * r0 + r1 * r1 + r2 * r2
+    distance = math.sqrt(rr)
+    k = 3.0 * mu / (rr * rr * distance)
+    radial = 0.5 * (I[0] + I[4] + I[8]) - 2.5 * (s0 * y0 + s1 * y1 + s2 * y2) / rr
+    g = mu * m / (rr * distance)
+    t0, t1, t2 = _cross(r0, r1, r2, w0, w1, w2)
+    return (
+        -g * r0 - k * (radial * r0 + w0),
+        -g * r1 - k * (radial * r1 + w1),
+        -g * r2 - k * (radial * r2 + w2),
+        k * t0,
+        k * t1,
+        k * t2,
+    )
 
 
 @njit(**_INLINE)
@@ -132,8 +192,10 @@ class KernelProblem(NamedTuple):
     torque (world); ``points`` (k, 3), ``point_forces`` (k, 3): body points and the constant
     world forces there (magnetic dipoles among them, see
     :func:`~tumble.rigid.forces.compiled_loads`); ``axes`` (3, 3), ``moments`` (3,): the
-    principal axes and moments (the ``split`` loops). For the batch loops ``inv_I``, ``m``,
-    ``F``, ``axes`` and ``moments`` carry a leading body axis.
+    principal axes and moments (the ``split`` loops); ``gravity`` (g, 4): one row
+    ``(μ, c)`` per :class:`~tumble.rigid.forces.GravityGradient`, ``inertia`` (3, 3): the
+    body's, which its torque needs. For the batch loops ``inv_I``, ``m``, ``F``, ``axes``,
+    ``moments`` and ``inertia`` carry a leading body axis.
     """
 
     correct: bool
@@ -147,6 +209,8 @@ class KernelProblem(NamedTuple):
     point_forces: np.ndarray
     axes: np.ndarray
     moments: np.ndarray
+    gravity: np.ndarray
+    inertia: np.ndarray
 
 
 class Records(NamedTuple):

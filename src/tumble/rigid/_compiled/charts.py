@@ -314,14 +314,15 @@ def _batch(problem, grid, Z, RN, every, records, counts, failed, causes):
     """:data:`LOOP` over all the steps of ``grid`` for every body ``k`` in parallel.
 
     Body ``k``'s state is ``Z[k]`` (and ``RN[k]``), its data ``problem.inv_I[k]``,
-    ``problem.m[k]``, ``problem.F[k]``, ``problem.axes[k]`` and ``problem.moments[k]``; its
-    samples go to ``records.t[k]``, … ; ``counts[k]`` samples, the failed step ``failed[k]``
-    (-1 if none) and its cause ``causes[k]`` come back.
+    ``problem.m[k]``, ``problem.F[k]``, ``problem.axes[k]``, ``problem.moments[k]`` and
+    ``problem.inertia[k]``; its samples go to ``records.t[k]``, … ; ``counts[k]`` samples,
+    the failed step ``failed[k]`` (-1 if none) and its cause ``causes[k]`` come back.
     """
     for k in prange(Z.shape[0]):
         p = problem
         body = KernelProblem(p.correct, p.A, p.b, p.inv_I[k], p.m[k], p.F[k], p.tau, p.points,
-                       p.point_forces, p.axes[k], p.moments[k])  # fmt: skip
+                       p.point_forces, p.axes[k], p.moments[k], p.gravity,
+                       p.inertia[k])  # fmt: skip
         body_records = Records(records.t[k], records.R[k], records.q[k], records.Y[k])
         counts[k], failed[k], causes[k] = LOOP(body, grid, (Z[k], RN[k]), 0, grid.n, every,  # noqa: F821
                                                0, body_records)  # fmt: skip

@@ -20,6 +20,7 @@ from tumble.rigid._compiled.base import (
     _copy,
     _copy_matrix,
     _cross,
+    _gradient,
     _times_matrix,
     _turn,
 )
@@ -151,7 +152,8 @@ def _dmv_flow(Rp, L0, L1, L2, moments, h, work, head, tail):
 @njit(**_INLINE)
 def _kick(problem, z, Rp, s):
     """``(p, L) += s (F, τ)`` at the state ``(z, R_p)``; body vectors ``r`` are turned by
-    ``R r = R_p (Pᵀ r)``."""
+    ``R r = R_p (Pᵀ r)``, and a point mass's gravity gradient (:func:`~.base._gradient`)
+    takes the inertia in the principal frame, ``R I Rᵀ = R_p diag(I₁, I₂, I₃) R_pᵀ``."""
     P = problem.axes
     for c in range(3):
         z[3 + c] += s * problem.F[c]
@@ -161,6 +163,23 @@ def _kick(problem, z, Rp, s):
         r0, r1, r2 = _apply(Rp, *_apply_transpose(P, points[k, 0], points[k, 1], points[k, 2]))
         f0, f1, f2 = point_forces[k, 0], point_forces[k, 1], point_forces[k, 2]
         t0, t1, t2 = _cross(r0, r1, r2, f0, f1, f2)
+        z[3] += s * f0
+        z[4] += s * f1
+        z[5] += s * f2
+        z[6] += s * t0
+        z[7] += s * t1
+        z[8] += s * t2
+    gravity, M = problem.gravity, problem.moments
+    if gravity.shape[0] == 0:
+        return
+    Rt = (Rp[0, 0], Rp[0, 1], Rp[0, 2], Rp[1, 0], Rp[1, 1], Rp[1, 2], Rp[2, 0], Rp[2, 1],
+          Rp[2, 2])  # fmt: skip
+    It = (M[0], 0.0, 0.0, 0.0, M[1], 0.0, 0.0, 0.0, M[2])
+    for k in range(gravity.shape[0]):
+        f0, f1, f2, t0, t1, t2 = _gradient(
+            gravity[k, 0], problem.m, z[0] - gravity[k, 1], z[1] - gravity[k, 2],
+            z[2] - gravity[k, 3], Rt, 0.0, 0.0, 0.0, 0.0, 0.0, It,
+        )  # fmt: skip
         z[3] += s * f0
         z[4] += s * f1
         z[5] += s * f2
@@ -204,7 +223,7 @@ def _split_loop(problem, grid, state, k0, k1, every, step0, records):
     t_a, t_b, h, n = grid
     weights, mass = problem.b, problem.m
     saved, R_saved, work = np.empty(9), np.empty((3, 3)), np.empty(WORK_SIZE)
-    loaded = problem.points.shape[0] > 0
+    loaded = problem.points.shape[0] > 0 or problem.gravity.shape[0] > 0
     for c in range(3):
         loaded = loaded or problem.F[c] != 0.0 or problem.tau[c] != 0.0
     merge = MERGES and not loaded  # noqa: F821
