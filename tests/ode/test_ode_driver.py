@@ -536,3 +536,28 @@ def test_members_have_the_same_outcome_in_one_block_or_many(block_steps, every):
 
 def test_a_run_of_one_member_has_no_members():
     assert run(Decay()).members is None and run(BlockDecay()).members is None
+
+
+class Judged(Controlled):
+    """Controlled whose own norm says every error is 0: the controller then grows each step
+    by its largest factor (MAX_FACTOR = 10)."""
+
+    def __init__(self):
+        self.seen = []
+
+    def norm(self, error, old, new, control):
+        self.seen.append((error[0], old[0], new[0]))
+        return 0.0
+
+
+def test_the_steppers_norm_is_what_the_controller_judges():
+    stepper = Judged()
+    out = march(stepper, (0.0, 2.0), np.array([1.0]), h=0.01, control=Control(1e-6, 1e-9))
+    # steps of 0.01, 0.1 and 1, the last cut to land on t1 (the default norm would reject)
+    np.testing.assert_allclose(out.t, [0.0, 0.01, 0.11, 1.11, 2.0], rtol=1e-15)
+    assert out.n_rejected == 0 and len(stepper.seen) == 4
+    for (error, old, new), t_old, t_new, y_old in zip(
+        stepper.seen, out.t[:-1], out.t[1:], out.records[0][:-1, 0], strict=True
+    ):  # each call: the step's error estimate, its start and its end
+        new_state, estimate = Controlled().step(t_old, np.array([y_old]), t_new - t_old)
+        assert (error, old, new) == (estimate[0], y_old, new_state[0])
