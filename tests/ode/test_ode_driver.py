@@ -32,8 +32,11 @@ class BlockDecay(Decay):
     """The same steps, marched in blocks by a compiled part (as the kernels are)."""
 
     def __init__(self, block_steps=None):
-        self.compiled = Compiled(self.march_block, block_steps=block_steps)
-        self.calls = []
+        self.block_steps, self.calls = block_steps, []
+
+    @property
+    def compiled(self):
+        return Compiled(self.march_block, block_steps=self.block_steps)
 
     def march_block(self, y, grid, k0, k1, every, step0):
         self.calls.append((k0, k1, step0))
@@ -178,8 +181,11 @@ class StepsDecay(BlockDecay):
 
     def __init__(self):
         super().__init__()
-        self.compiled = Compiled(self.march_block, rewind=self.rewind, steps=True)
         self.steps, self.rewound = 0, None
+
+    @property
+    def compiled(self):
+        return Compiled(self.march_block, rewind=self.rewind, steps=True)
 
     def march_block(self, y, grid, k0, k1, every, step0):
         times = [grid.time(k) for k in range(k0, k1 + 1)]
@@ -430,7 +436,10 @@ class CannedAdaptive(Controlled):
 
     def __init__(self, ending, finite=True):
         self.ending, self.finite, self.calls = ending, finite, []
-        self.compiled = Compiled(print, march_adaptive=self.march_adaptive)
+
+    @property
+    def compiled(self):
+        return Compiled(print, march_adaptive=self.march_adaptive)
 
     def march_adaptive(self, y, t, t1, h, control, every, step0, max_steps):
         self.calls.append((t, h, step0))
@@ -470,8 +479,11 @@ class Decays(Stepper):
     time_axis = 1
 
     def __init__(self, n, block_steps=None):
-        self.failed = np.full(n, -1)
-        self.compiled = Compiled(self.march_block, block_steps=block_steps)
+        self.failed, self.block_steps = np.full(n, -1), block_steps
+
+    @property
+    def compiled(self):
+        return Compiled(self.march_block, block_steps=self.block_steps)
 
     def record(self, y):
         return (y[:, None],)

@@ -349,10 +349,12 @@ class CompiledRungeKutta(RungeKutta):
         self.size = FIRST_BLOCK
         self._nfev: np.ndarray | None = None  # after each step of the last block
         self._control: tuple = (None, None, None)  # (control, atol, settings)
-        self.compiled = Compiled(
-            self._march_block, self._march_adaptive if tableau.adaptive else None,
-            self._rewind, steps=interpolants,
-        )  # fmt: skip
+
+    @property
+    def compiled(self) -> Compiled:
+        """The loops as the compiled part (made when asked: no reference cycle)."""
+        adaptive = self._march_adaptive if self.tableau.adaptive else None
+        return Compiled(self._march_block, adaptive, self._rewind, self.interpolants)
 
     def _march_block(
         self, state: np.ndarray, grid: Grid, k0: int, k1: int, every: int, step0: int

@@ -502,8 +502,13 @@ class BatchStepper(Stepper):
         n_bodies = len(problem.m)
         self.failed = np.full(n_bodies, -1, dtype=np.int64)
         self.causes = np.zeros(n_bodies, dtype=np.int64)
-        self.compiled = Compiled(self._march_block, block_steps=block_steps)
+        self._block_steps = block_steps
         self._handed: tuple = (None, None)  # the state the last block handed back, its (Z, RN)
+
+    @property
+    def compiled(self) -> Compiled:
+        """The batch loop as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block, block_steps=self._block_steps)
 
     def start(self, state: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """The stepped state for ``(R, Y)`` with a leading body axis."""
@@ -532,9 +537,9 @@ class BatchStepper(Stepper):
                        self.failed, self.causes)  # fmt: skip
         failed = np.where(before < 0, self.failed, -1)  # those that stopped in this block
         messages = {
-            k: unconverged_message(self.method, grid.time(step - 1), grid.time(step))
-            for k, step in enumerate(failed.tolist())
-            if step >= 0 and self.causes[k] == UNCONVERGED
+            k: unconverged_message(self.method, grid.time(failed[k] - 1), grid.time(failed[k]))
+            for k in np.flatnonzero(failed >= 0).tolist()
+            if self.causes[k] == UNCONVERGED
         }
         q = records.q if self.family.quaternion else np.empty((n_bodies, size, 0))
         new = self.family.read(Z, RN)

@@ -135,7 +135,11 @@ class CompiledCrouchGrossmanStepper(CrouchGrossmanStepper):
 
         super().__init__(method, dynamics)
         self.problem, self.loop = problem, COMPILED_CG.loop
-        self.compiled = Compiled(self._march_block)
+
+    @property
+    def compiled(self) -> Compiled:
+        """The loop as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block)
 
     def _march_block(
         self, state: RigidState, grid: Grid, k0: int, k1: int, every: int, step0: int

@@ -244,9 +244,13 @@ class CompiledStepper(RigidStepper):
         super().__init__(method, chart, dynamics)
         self.problem, self.loop = problem, COMPILED[self.chart.name].loop
         self.adaptive_loop = COMPILED[self.chart.name].adaptive
-        adaptive = method.adaptive and self.adaptive_loop is not None
-        self.compiled = Compiled(self._march_block, self._march_adaptive if adaptive else None)
+        self._adaptive = method.adaptive and self.adaptive_loop is not None
         self._handed: tuple = (None, None)  # the state the last block handed back, its (z, Rn)
+
+    @property
+    def compiled(self) -> Compiled:
+        """The chart's loops as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block, self._march_adaptive if self._adaptive else None)
 
     def _march_adaptive(
         self, state: RigidState, t: float, t1: float, h: float, control: Control, every: int,
@@ -314,7 +318,11 @@ class CompiledSplitStepper(SplitStepper):
         super().__init__(method, dynamics, (problem.moments, problem.axes))
         assert method.flow is not None
         self.problem, self.loop = problem, COMPILED_FLOWS[method.flow].loop
-        self.compiled = Compiled(self._march_block)
+
+    @property
+    def compiled(self) -> Compiled:
+        """The flow's loop as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block)
 
     def _march_block(
         self, state: RigidState, grid: Grid, k0: int, k1: int, every: int, step0: int

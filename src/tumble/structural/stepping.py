@@ -190,12 +190,17 @@ class CompiledBeamStepper(Watched):
         permuted_map = np.where(dof_map >= 0, self.inverse[np.maximum(dof_map, 0)], -1)
         self.frame = (permuted_map.astype(np.int32), *element_arrays)
         self.damping = _csr_arrays(None if C is None else sp.csr_matrix(C)[order][:, order])
-        self.compiled = Compiled(self._march_block, block_steps=block)
+        self._block = block
         self.system, self.solve = system, factors[0].solve
         self.kernel, self.what = scheme.kernel, f"the structural time loop ({scheme.name})"
         self.coefficients = scheme.coefficients(dt)
         self.work = tuple(np.zeros(order.size) for _ in range(self.kernel.work))
         self.lag = self.work[self.kernel.lag] if self.kernel.lag >= 0 else np.zeros(0)
+
+    @property
+    def compiled(self) -> Compiled:
+        """The time loop as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block, block_steps=self._block)
 
     def start(self, state: BeamState, acceleration_energy: float = 0.0) -> BeamState:
         """``state`` in the factor's DOF order, and the watch from it."""
