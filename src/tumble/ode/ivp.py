@@ -273,8 +273,7 @@ def solve(
     control = None
     if tableau.adaptive:
         control = Control(float(rtol), atol_array, _CONTROLLER)
-        part = stepper.compiled
-        if h is None and (part is None or part.march_adaptive is None):  # else its loop does
+        if h is None and not is_compiled(fun):  # else the compiled adaptive loop chooses it
             h = initial_step(counted, t0, y, stepper.f, tableau.error_order, rtol, atol_array)
     # Non-finite values are detected and reported as a status, not as numpy warnings.
     with np.errstate(over="ignore", invalid="ignore"):
