@@ -100,3 +100,57 @@ def test_no_structural_scheme_is_tested_by_its_class():
                 if names & schemes:
                     found.append(f"{path.relative_to(SOURCE)}:{node.lineno}")
     assert not found, found
+
+
+STEPPER = {"step", "accept", "interpolant", "norm", "record", "error_order", "time_axis",
+           "compiled"}  # fmt: skip
+"""What a stepper of the one driver is: four methods, the record of a state, the order of
+its error estimate, its record's time axis, and its optional compiled part."""
+COMPILED_PART = ("march_block", "march_adaptive", "rewind", "steps", "block_steps")
+"""The compiled part: its blocks (fixed, adaptive), what a terminal event makes it forget,
+whether its blocks return their steps, and how many steps a block may take."""
+OLD_CONTRACT = {"blocks", "adaptive_blocks", "block_interpolants", "block_steps", "finite",
+                "failure", "scale", "march_block", "march_adaptive", "rewind", "in_place",
+                "adaptive"}  # fmt: skip
+"""The flags and methods of the contract before issue 25 (12 methods, 7 flags and
+``in_place``), gone from every stepper class."""
+
+
+def test_the_stepper_contract_is_narrow():
+    """A stepper is :data:`STEPPER`, its compiled part :data:`COMPILED_PART` (and the one
+    question the driver asks it, ``takes``); no stepper class keeps the old flags."""
+    from tumble.ode.contract import Compiled, Stepper
+
+    assert {name for name in vars(Stepper) if not name.startswith("_")} == STEPPER
+    assert Compiled._fields == COMPILED_PART
+    methods = {name for name in vars(Compiled) if not name.startswith("_")}
+    assert methods - set(COMPILED_PART) == {"takes"}
+    import tumble.ode.compiled
+    import tumble.rigid.batch
+    import tumble.structural.stepping  # noqa: F401  (every stepper class of the library)
+
+    classes = {cls for cls in _subclasses(Stepper) if cls.__module__.startswith("tumble.")}
+    assert len(classes) >= 10
+    stale = {
+        f"{cls.__module__}.{cls.__name__}.{name}"
+        for cls in classes
+        for name in vars(cls)
+        if name in OLD_CONTRACT
+    }
+    assert not stale, sorted(stale)
+
+
+def test_the_driver_reads_of_a_stepper_only_its_contract():
+    """Every attribute :mod:`tumble.ode.driver` takes of a stepper (``stepper.x``,
+    ``run.stepper.x``) or of its compiled part (``part.x``) is in the contract: the driver
+    chooses its loop by asking whether there is a compiled part for the run, not by flags."""
+    tree = _tree(SOURCE / "ode" / "driver.py")
+    read = defaultdict(set)
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute):
+            owner = node.value
+            name = owner.id if isinstance(owner, ast.Name) else getattr(owner, "attr", "")
+            if name in ("stepper", "part"):
+                read[name].add(node.attr)
+    assert read["stepper"] and read["stepper"] <= STEPPER, read["stepper"]
+    assert read["part"] and read["part"] <= {*COMPILED_PART, "takes"}, read["part"]

@@ -38,7 +38,7 @@ def _one_step(tableau, t0: float, h: float):
 
     stepper = RungeKutta(recorded, tableau, t0, y0)
     y1, _ = stepper.step(t0, y0, h)
-    stepper.accept(t0 + h, y1)
+    stepper.accept(t0, y0, t0 + h, y1)
     before = len(evaluations)
     sol = stepper.interpolant(t0, y0, t0 + h, y1)
     if tableau.dense is None:

@@ -20,7 +20,8 @@ from tumble.rigid import (
     simulate_batch,
     soa,
 )
-from tumble.rigid.batch import SOA_FAMILIES, SOA_MIN_BODIES
+from tumble.rigid import batch as batch_module
+from tumble.rigid.batch import FIXED_METHODS, SOA_FAMILIES, SOA_MIN_BODIES
 from tumble.rigid.soa import BLOCK
 
 FIXED = [name for name, method in METHODS.items() if not method.adaptive and not method.exact]
@@ -219,6 +220,7 @@ def test_events_are_refused(body):
         ),
         (dict(omega0=OMEGA0, h=-0.1), "h=-0.1"),
         (dict(omega0=OMEGA0, record_every=0), "record_every=0"),
+        (dict(omega0=OMEGA0, progress="x"), r"progress='x' is not allowed: must be True or"),
     ],
     ids=lambda value: None if isinstance(value, dict) else value[:24],
 )
@@ -342,3 +344,59 @@ def test_stage_terms_leave_out_zero_weights_only_when_no_b_is_zero(method):
         kept = [l for l in range(len(weights)) if weights[l] != 0 or i == s or not b.all()]
         np.testing.assert_array_equal(terms[i, : count[i]], kept)
         np.testing.assert_array_equal(w[i, : count[i]], weights[kept])
+
+
+def _stopping(n: int) -> dict:
+    """``n`` bodies of which body 1 overflows in step 80 and body 2 in step 40 (x grows by
+    h v from 1e308 up to 1.8e308), the others spinning on."""
+    x0, v0 = np.zeros((n, 3)), np.tile([1.0, 0.0, 0.0], (n, 1))
+    x0[1:3], v0[1], v0[2] = [1e308, 0.0, 0.0], [1e307, 0.0, 0.0], [2e307, 0.0, 0.0]
+    return dict(x0=x0, v0=v0, omega0=np.resize(OMEGA0, (n, 3)))
+
+
+@pytest.mark.parametrize("n", [4, SOA_MIN_BODIES + 3], ids=["few", "columns"])
+@pytest.mark.parametrize("method", FIXED_METHODS)
+def test_a_batch_in_many_blocks_has_the_numbers_of_one_block_bit_for_bit(
+    body, method, n, monkeypatch
+):
+    """The driver marches the batch in blocks that end on recorded steps and keeps each
+    body's account over them (its status, message, steps and last finite state): in one
+    block, in blocks of one sample (3 steps) and in the progress bar's, the same numbers."""
+    options = dict(method=method, h=0.1, record_every=3, **_stopping(n))
+    one = simulate_batch(body, 10.0, **options)
+    shown = simulate_batch(body, 10.0, progress=True, **options)
+    monkeypatch.setattr(batch_module, "BLOCK_BYTES", 1)  # one sample of each body a block
+    many = simulate_batch(body, 10.0, **options)
+    assert list(one.status[:4]) == [0, -1, -1, 0] and list(one.n_steps[:4]) == [100, 79, 39, 100]
+    for other in (shown, many):
+        for name in ("t", "x", "v", "R", "L_world", "q", "n_steps", "n_recorded", "t_last"):
+            np.testing.assert_array_equal(getattr(other, name), getattr(one, name), name)
+        np.testing.assert_array_equal(other.status, one.status)
+        assert other.messages == one.messages
+
+
+def test_a_batch_marches_in_blocks_of_bounded_records(body, monkeypatch):
+    """BLOCK_BYTES bounds a block's records: blocks of whole samples of every body."""
+    calls = []
+    march_block = batch_module.BatchStepper._march_block
+
+    def counted(self, state, grid, k0, k1, every, step0):
+        calls.append((k0, k1))
+        return march_block(self, state, grid, k0, k1, every, step0)
+
+    monkeypatch.setattr(batch_module.BatchStepper, "_march_block", counted)
+    monkeypatch.setattr(batch_module, "BLOCK_BYTES", 2 * N * batch_module.SAMPLE_BYTES)
+    simulate_batch(body, 1.0, h=0.1, omega0=OMEGA0, record_every=3)  # 10 steps
+    assert calls == [(0, 6), (6, 10)]  # two samples of every body a block, then the rest
+
+
+@pytest.mark.parametrize("method", FIXED_METHODS)
+def test_a_single_run_in_the_progress_bars_blocks_has_the_numbers_of_one_block(body, method):
+    """What a batch's body is compared with: ``simulate`` marches in blocks too with a
+    progress bar, and they end on recorded steps and go on from the loop's own arrays, so
+    the axes flow's merged half turns and the quat chart's normalisation do not see them."""
+    options = dict(method=method, h=0.01, omega0=OMEGA0[0], record_every=7)
+    one = simulate(body, 3.0, **options)
+    shown = simulate(body, 3.0, progress=True, **options)
+    for name in ("t", "R", "L_world", "x", "q"):
+        np.testing.assert_array_equal(getattr(shown, name), getattr(one, name), name)

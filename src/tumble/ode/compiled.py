@@ -2,11 +2,12 @@
 
 When the right-hand side handed to :func:`tumble.solve` is a numba-compiled function (a
 ``CPUDispatcher``, made by ``@numba.njit``), the stepper :func:`tumble.ode.driver.march` runs
-is :class:`CompiledRungeKutta`: :class:`tumble.ode.ivp.RungeKutta` whose fixed grids
-(``march_block``, :func:`_fixed_loop`) and adaptive steps (``march_adaptive``,
-:func:`_adaptive_loop`) run in numba loops that call ``fun`` from compiled code, with no
-Python per step. Everything around the steps is the driver's, as for every stepper: the
-record, the status and its message, ``max_steps``, events, dense output. The loops are the
+is :class:`CompiledRungeKutta`: :class:`tumble.ode.ivp.RungeKutta` with a compiled part
+whose fixed grids (``march_block``, :func:`_fixed_loop`) and adaptive steps
+(``march_adaptive``, :func:`_adaptive_loop`) run in numba loops that call ``fun`` from
+compiled code, with no Python per step. Everything around the steps is the driver's, as
+for every stepper: the record, the status and its message, ``max_steps``, events, dense
+output. The loops are the
 Python stepper's algorithm and must give its result to round-off
 (``tests/ode/test_ode_compiled.py`` compares the two for every tableau of
 :data:`~tumble.ode.tableaux.TABLEAUX`):
@@ -24,8 +25,8 @@ Python stepper's algorithm and must give its result to round-off
 * with events or dense output (``interpolants=True``) each accepted step also records its
   interpolant's coefficients ``Q`` (:func:`tumble.ode.dense.step_coefficients`' formulas as
   scalar loops: the tableau's own extension with its extra stages, or the cubic Hermite
-  one), and each block hands the driver its steps (``Block.steps``,
-  ``block_interpolants``): the driver locates the events on them with its
+  one), and each block hands the driver its steps (``Block.steps``, the part's
+  ``steps``): the driver locates the events on them with its
   :class:`~tumble.ode.events.EventTracker` (the events may be compiled or not) and keeps
   them as the dense output.
 
@@ -58,7 +59,7 @@ from numba import njit
 from tumble.ode import control
 from tumble.ode.contract import FAILURES, MINIMUM_STEP, NON_FINITE, OK
 from tumble.ode.dense import StepInterpolant
-from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Steps
+from tumble.ode.driver import AdaptiveBlock, Block, Compiled, Control, Grid, Steps
 from tumble.ode.ivp import RungeKutta
 from tumble.ode.tableaux import ButcherTableau
 from tumble.ode.templates import GRID_TIME as _GRID_TIME
@@ -318,7 +319,9 @@ def _call(loop, args: tuple) -> tuple:
 
 class CompiledRungeKutta(RungeKutta):
     """:class:`~tumble.ode.ivp.RungeKutta` whose steps run in numba: the stepper of
-    :func:`tumble.solve` for a compiled ``fun``.
+    :func:`tumble.solve` for a compiled ``fun``. Its compiled part
+    (:class:`~tumble.ode.driver.Compiled`) marches fixed grids in :func:`_fixed_loop` and,
+    for an adaptive tableau, adaptive steps in :func:`_adaptive_loop`.
 
     Parameters
     ----------
@@ -332,49 +335,52 @@ class CompiledRungeKutta(RungeKutta):
     t0, y0 : float, ndarray of shape (n,)
         The initial point.
     interpolants : bool
-        Whether the blocks return their steps with their interpolants
-        (``block_interpolants``): for events and dense output, which then stay compiled.
+        Whether the blocks return their steps with their interpolants (the part's
+        ``steps``): for events and dense output, which then stay compiled.
     """
-
-    blocks = True
 
     def __init__(self, fun: Callable, compiled: Callable, tableau: ButcherTableau, t0: float,
                  y0: np.ndarray, *, interpolants: bool):  # fmt: skip
         super().__init__(fun, tableau, t0, y0)
-        self.compiled, self.tab = compiled, _tableau(tableau)
-        self.adaptive_blocks, self.block_interpolants = tableau.adaptive, interpolants
+        self.jitted, self.tab = compiled, _tableau(tableau)
+        self.interpolants = interpolants
         self._flags = (tableau.fsal, self.tab.hermite, interpolants)  # _adaptive_loop's
         self.f = np.array(self.f, dtype=float)  # updated in place by the loops
         self.size = FIRST_BLOCK
-        self.compiled_evaluations = 0
         self._nfev: np.ndarray | None = None  # after each step of the last block
         self._control: tuple = (None, None, None)  # (control, atol, settings)
 
-    def march_block(
+    @property
+    def compiled(self) -> Compiled:
+        """The loops as the compiled part (made when asked: no reference cycle)."""
+        adaptive = self._march_adaptive if self.tableau.adaptive else None
+        return Compiled(self._march_block, adaptive, self._rewind, self.interpolants)
+
+    def _march_block(
         self, state: np.ndarray, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
         y = np.array(state, dtype=float)
-        out = _arrays(k1 - k0, y.size, self.tab.q, self.block_interpolants, adaptive=False)
+        out = _arrays(k1 - k0, y.size, self.tab.q, self.interpolants, adaptive=False)
         grid_tuple = (float(grid.t0), float(grid.t1), float(grid.h), int(grid.n))
         count, failed, self.compiled_evaluations = _call(_fixed_loop, (
-            self.compiled, self.tab.arrays, self.tab.hermite, self.block_interpolants,
+            self.jitted, self.tab.arrays, self.tab.hermite, self.interpolants,
             grid_tuple, k0, k1, y, self.f, self.compiled_evaluations, out))  # fmt: skip
         self._nfev = out[3]
         every_th = slice((-(step0 + k0) - 1) % every, count, every)
         steps = self._steps(grid.time(k0), state, out, count)
         return Block(out[0][every_th], (out[1][every_th],), y, failed, steps)
 
-    def march_adaptive(
+    def _march_adaptive(
         self, state: np.ndarray, t: float, t1: float, h: float, control: Control, every: int,
         step0: int, max_steps: float,
     ) -> AdaptiveBlock:  # fmt: skip
         y = np.array(state, dtype=float)
         size = max(1, int(min(self.size, max_steps)))
         self.size = min(2 * self.size, LARGEST_BLOCK)
-        out = _arrays(size, y.size, self.tab.q, self.block_interpolants, adaptive=True)
+        out = _arrays(size, y.size, self.tab.q, self.interpolants, adaptive=True)
         atol, settings = self._settings(control, y.size)
         count, t_end, h_next, rejected, code, t_failed, finite, nfev = _call(_adaptive_loop, (
-            self.compiled, self.tab.arrays, self._flags, float(t), float(t1), float(h),
+            self.jitted, self.tab.arrays, self._flags, float(t), float(t1), float(h),
             float(control.rtol), atol, settings, y, self.f, self.compiled_evaluations,
             float(max_steps), out))  # fmt: skip
         self.compiled_evaluations, self._nfev = nfev, out[3]
@@ -383,14 +389,14 @@ class CompiledRungeKutta(RungeKutta):
         return AdaptiveBlock(out[0][every_th], (out[1][every_th],), y, t_end, h_next, count,
                              rejected, FAILURES[code], t_failed, finite, steps)  # fmt: skip
 
-    def rewind(self, block: Block | AdaptiveBlock, index: int) -> None:
+    def _rewind(self, block: Block | AdaptiveBlock, index: int) -> None:
         """A terminal event in step ``index``: the evaluations counted stop with that step."""
         assert self._nfev is not None
         self.compiled_evaluations = int(self._nfev[index])
 
     def _steps(self, t: float, state: np.ndarray, out: tuple, count: int) -> Steps | None:
-        """The block's steps and their interpolants, with ``block_interpolants``."""
-        if not self.block_interpolants:
+        """The block's steps and their interpolants, with ``interpolants``."""
+        if not self.interpolants:
             return None
         ts, ys, Qs = out[0][:count], out[1][:count], out[2]
         interpolants = []

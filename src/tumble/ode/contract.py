@@ -1,9 +1,11 @@
 """The driver's contract: what a stepper provides, what a run returns, and how it ended.
 
-:func:`tumble.ode.driver.march` runs any :class:`Stepper`; a compiled one hands it a
-:class:`Block` (fixed steps on a :class:`Grid`) or an :class:`AdaptiveBlock` at a time. A run
-ends with an :class:`Outcome` and a :class:`Status` whose message names the time. These types
-are re-exported by :mod:`tumble.ode.driver`, where the contract is described in full.
+:func:`tumble.ode.driver.march` runs any :class:`Stepper`: its Python step, or the blocks of
+its optional :class:`Compiled` part (a :class:`Block` of fixed steps on a :class:`Grid`, or
+an :class:`AdaptiveBlock`). A run ends with an :class:`Outcome` and a :class:`Status` whose
+message names the time; a run of many members (a batch) also with each one's
+(:class:`Members`, from its blocks' :class:`Stops`). These types are re-exported by
+:mod:`tumble.ode.driver`, where the contract is described in full.
 """
 
 from __future__ import annotations
@@ -93,7 +95,7 @@ class Grid(NamedTuple):
 @dataclass
 class Steps:
     """A compiled block's accepted steps, for events, dense output and ``t_eval``
-    (``Block.steps``, from a stepper with ``block_interpolants``).
+    (``Block.steps``, from a part with :attr:`Compiled.steps`).
 
     Attributes
     ----------
@@ -102,7 +104,7 @@ class Steps:
     states : sequence
         The state at each ``t``.
     interpolants : sequence of callable
-        ``sol(t)`` on each step (:meth:`Stepper.interpolant`).
+        ``sol(t)`` on each step (as :meth:`Stepper.interpolant`).
     n_rejected : ndarray of int, shape (m,), optional
         Steps rejected in the block up to each accepted one (adaptive blocks).
     """
@@ -114,8 +116,31 @@ class Steps:
 
 
 @dataclass
+class Stops:
+    """Where the members of a block stopped (``Block.stops``): a stepper that marches many
+    members at once (the bodies of a batch), each of which stops alone.
+
+    Attributes
+    ----------
+    recorded : ndarray of int, shape (N,)
+        The samples each member recorded in the block: all of the block's, unless it stopped
+        in it (then those before), or before it (then 0).
+    failed : ndarray of int, shape (N,)
+        For a member that stopped in this block, the grid step whose result was not finite
+        (its state is left at the step before, and no later block marches it); else -1.
+    messages : dict of int to str
+        Why, for those of them whose reason is not a non-finite state (by default
+        :func:`non_finite_message`).
+    """
+
+    recorded: np.ndarray
+    failed: np.ndarray
+    messages: dict[int, str] = field(default_factory=dict)
+
+
+@dataclass
 class Block:
-    """What a compiled block of steps returns.
+    """What a compiled block of steps returns (:attr:`Compiled.march_block`).
 
     Attributes
     ----------
@@ -128,7 +153,13 @@ class Block:
     failed : int
         The grid step whose result was not finite (the block stopped before it), or -1.
     steps : Steps, optional
-        Every accepted step (a stepper with ``block_interpolants``).
+        Every accepted step (a part with :attr:`Compiled.steps`).
+    message : str, optional
+        Why the block stopped at ``failed``, if not a non-finite state (an unconverged
+        implicit solve, an energy past its bound).
+    stops : Stops, optional
+        Where its members stopped, for a stepper of many members (they stop alone:
+        ``failed`` stays -1).
     """
 
     t: np.ndarray
@@ -136,31 +167,81 @@ class Block:
     state: Any
     failed: int = -1
     steps: Steps | None = None
+    message: str | None = None
+    stops: Stops | None = None
+
+
+def finite(state: Any) -> bool:
+    """Whether every number of ``state`` (an array, or a tuple of arrays) is finite."""
+    parts = state if isinstance(state, tuple) else (state,)
+    return all(bool(np.isfinite(part).all()) for part in parts)
+
+
+class Compiled(NamedTuple):
+    """A stepper's compiled part (:attr:`Stepper.compiled`): it marches blocks of steps in
+    compiled code, with no Python per step (the driver's module docstring: the contract).
+
+    Attributes
+    ----------
+    march_block : callable
+        ``march_block(state, grid, k0, k1, every, step0) -> Block``: steps ``k0 + 1 … k1``
+        of a fixed :class:`Grid`, recording step ``k`` when ``step0 + k`` is a multiple of
+        ``every``.
+    march_adaptive : callable, optional
+        ``march_adaptive(state, t, t1, h, control, every, step0, max_steps) ->
+        AdaptiveBlock``: adaptive steps from ``t`` towards ``t1``. None: adaptive runs step
+        in Python.
+    rewind : callable, optional
+        ``rewind(block, index)``: a terminal event ended the run in step ``index`` of
+        ``block``; forget what was counted for its later steps. None: nothing to forget.
+    steps : bool
+        Whether its blocks return their steps (``Block.steps``), so that runs with events,
+        dense output or ``t_eval`` march compiled too. Without, they step in Python.
+    block_steps : int, optional
+        At most this many steps per ``march_block`` call (None: as many as the run allows).
+    """
+
+    march_block: Callable[..., Block]
+    march_adaptive: Callable[..., AdaptiveBlock] | None = None
+    rewind: Callable[[Any, int], None] | None = None
+    steps: bool = False
+    block_steps: int | None = None
+
+    def takes(self, adaptive: bool, follows: bool) -> bool:
+        """Whether it marches a run, adaptive or not, whose steps are followed (events,
+        dense output, ``t_eval``) or not: the one question the driver asks."""
+        return (self.march_adaptive is not None or not adaptive) and (self.steps or not follows)
 
 
 class Stepper:
-    """Defaults of the stepper contract (module docstring); subclasses override ``step``."""
+    """A stepper of :func:`~tumble.ode.driver.march`: one step in Python, and an optional
+    compiled part (the driver's module docstring: the contract). Subclasses override
+    :meth:`step`; the rest are defaults."""
 
-    adaptive: bool = False
     error_order: int = 1
-    blocks: bool = False
-    """Whether :meth:`march_block` runs a fixed grid compiled."""
+    """The order ``q`` of :meth:`step`'s error estimate (the controller's exponent is
+    ``1/(q + 1)``)."""
     time_axis: int = 0
-    """The axis of :meth:`record`'s arrays along which samples are stacked."""
-    block_steps: int | None = None
-    """At most this many steps per :meth:`march_block` call (None: the whole grid)."""
-    block_interpolants: bool = False
-    """Whether its blocks return their steps (``Block.steps``) for events and dense output."""
+    """The axis of :meth:`record`'s arrays along which samples are stacked (1 for a stepper
+    of many members, whose records put the members first)."""
 
-    def start(self, state: Any) -> Any:
-        """The stepped state for a caller's initial state (by default the same object)."""
-        return state
+    @property
+    def compiled(self) -> Compiled | None:
+        """The compiled part, or None: every run steps in Python. A stepper that has one
+        makes it when asked (a property): a part kept on the stepper would hold its bound
+        methods, and so the stepper, in a reference cycle that only the garbage collector
+        frees, with the run's arrays (measured: short compiled calls 10–20 % slower)."""
+        return None
 
     def step(self, t: float, state: Any, h: float) -> tuple[Any, np.ndarray | None]:
+        """One step of ``h`` from ``(t, state)``: the new state and its error estimate (or
+        None); ``state`` is left unchanged."""
         raise NotImplementedError
 
-    def accept(self, t: float, state: Any) -> None:
-        """A step to ``(t, state)`` was accepted."""
+    def accept(self, t_old: float, old: Any, t_new: float, new: Any) -> str | None:
+        """Take the accepted step to ``(t_new, new)``, or refuse it: why (the run then fails
+        there, with ``old``). By default a state that is not finite is refused."""
+        return None if finite(new) else non_finite_message(t_old, t_new)
 
     def interpolant(self, t_old: float, old: Any, t_new: float, new: Any) -> Callable:
         """The state between two accepted ones; by default a step from ``old`` to ``t``."""
@@ -170,46 +251,19 @@ class Stepper:
 
         return sol
 
-    def finite(self, state: Any) -> bool:
-        parts = state if isinstance(state, tuple) else (state,)
-        return all(bool(np.isfinite(part).all()) for part in parts)
-
-    def scale(self, state: Any) -> np.ndarray:
-        return np.abs(state)
-
-    adaptive_blocks: bool = False
-    """Whether :meth:`march_adaptive` runs adaptive steps compiled."""
-
     def norm(self, error: np.ndarray, old: Any, new: Any, control: Control) -> float:
-        """The weighted norm of ``error`` (Hairer's RMS over :meth:`scale`)."""
-        return error_norm(error, self.scale(old), self.scale(new), control.rtol, control.atol)
-
-    def march_adaptive(
-        self, state: Any, t: float, t1: float, h: float, control: Control, every: int,
-        step0: int, max_steps: float,
-    ) -> AdaptiveBlock:  # fmt: skip
-        raise NotImplementedError
-
-    def failure(self, t_old: float, t_new: float) -> str:
-        """Why the step from ``t_old`` to ``t_new`` gave a state that is not finite."""
-        return non_finite_message(t_old, t_new)
+        """The weighted norm of ``error`` (Hairer's RMS relative to ``|old|`` and ``|new|``,
+        :func:`~tumble.ode.control.error_norm`)."""
+        return error_norm(error, old, new, control.rtol, control.atol)
 
     def record(self, state: Any) -> tuple:
+        """One sample: arrays with a time axis of length 1 at :attr:`time_axis`."""
         return (np.asarray(state)[None],)
-
-    def rewind(self, block: Block | AdaptiveBlock, index: int) -> None:
-        """A terminal event ended the run in step ``index`` of ``block``: forget the later
-        steps (their counters)."""
-
-    def march_block(
-        self, state: Any, grid: Grid, k0: int, k1: int, every: int, step0: int
-    ) -> Block:
-        raise NotImplementedError
 
 
 @dataclass
 class AdaptiveBlock:
-    """What a compiled adaptive block returns (:meth:`Stepper.march_adaptive`).
+    """What a compiled adaptive block returns (:attr:`Compiled.march_adaptive`).
 
     Attributes
     ----------
@@ -226,7 +280,7 @@ class AdaptiveBlock:
         (``"non-finite"`` with ``t_failed`` the end of the failed step, ``"minimum-step"``
         with ``finite`` whether its last error norm was finite).
     steps : Steps, optional
-        Every accepted step (a stepper with ``block_interpolants``).
+        Every accepted step (a part with :attr:`Compiled.steps`).
     """
 
     t: np.ndarray
@@ -266,6 +320,34 @@ Jump = tuple[float, Callable[[Any], Any]]
 
 
 @dataclass
+class Members:
+    """Per member of a run of many members (``Outcome.members``), as the driver made it
+    from its blocks' :class:`Stops`.
+
+    Attributes
+    ----------
+    status : ndarray of int, shape (N,)
+        :class:`Status` codes: ``FAILED`` for a member that stopped, else the run's.
+    messages : list of str
+        Why each stopped (its step named), else the run's message.
+    n_steps : ndarray of int, shape (N,)
+        Accepted steps each took.
+    n_recorded : ndarray of int, shape (N,)
+        Its valid samples, the first ones of the record (the rows after are NaN); the last
+        is its last finite state.
+    t_last : ndarray, shape (N,)
+        The time of that last valid sample: for a member that stopped, the time of its last
+        finite state, between two recorded times when ``record_every > 1``.
+    """
+
+    status: np.ndarray
+    messages: list[str]
+    n_steps: np.ndarray
+    n_recorded: np.ndarray
+    t_last: np.ndarray
+
+
+@dataclass
 class Outcome:
     """What :func:`march` returns; the callers turn it into their result types.
 
@@ -285,6 +367,8 @@ class Outcome:
         Per event, the times and states where it fired.
     step_times, interpolants : list or None
         Every accepted step's end and its interpolant, with ``dense_output=True``.
+    members : Members or None
+        Per member, for a stepper of many members (its blocks report :class:`Stops`).
     """
 
     t: np.ndarray
@@ -298,3 +382,4 @@ class Outcome:
     y_events: list[list[Any]]
     step_times: list[float] | None
     interpolants: list[Callable] | None
+    members: Members | None = None

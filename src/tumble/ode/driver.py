@@ -2,62 +2,83 @@
 
 Every time loop in tumble is this one: ``solve`` (a Runge–Kutta tableau on a vector),
 ``simulate`` (a rigid-body chart, in Python or in compiled blocks), ``simulate_batch`` (many
-bodies in one compiled block) and the structural schemes (one factorised solve a step). What
+bodies at once, in compiled blocks) and the structural schemes (one factorised solve a step). What
 differs is the *stepper*; what the run does around the steps is written once, here.
 
 The stepper's contract
 ----------------------
-A stepper is an object with (see :class:`Stepper`, which gives the defaults):
+A stepper (:class:`Stepper` gives the defaults) is four methods and the record of a state:
 
-``adaptive`` : bool
-    Whether ``step`` returns an error estimate for the step controller.
-``error_order`` : int
-    Order ``q`` of that estimate (the controller's exponent is ``1/(q + 1)``).
 ``step(t, state, h) -> (new_state, error)``
-    One step from ``state`` at ``t``. ``error`` is the local error estimate (an array in the
-    units of :meth:`~Stepper.scale`) or None. It must not change ``state``: the driver may
-    need it again (events, a rejected step).
-``accept(t, state)``
-    Told that a step to ``(t, state)`` was accepted (first-same-as-last data, counters).
+    One step from ``state`` at ``t``. ``error`` is the local error estimate (an array that
+    :meth:`~Stepper.norm` weighs) or None; an adaptive run needs it. It must not change
+    ``state``: the driver may need it again (events, a rejected step).
+``accept(t_old, old, t_new, new) -> None or str``
+    The driver accepts the step to ``(t_new, new)``: the stepper takes it (first-same-as-last
+    data, counters), or refuses it with the reason, and the run fails there with that
+    message and the state ``old``. By default a state that is not finite is refused
+    (:func:`non_finite_message`); an implicit stepper names its unconverged solve, a
+    structural one the energy that outgrew its bound (:mod:`tumble.structural.divergence`).
 ``interpolant(t_old, old, t_new, new) -> sol``
     ``sol(t)`` for ``t`` in ``[t_old, t_new]``: the state between the two (the dense output
     that events are located on). Called only after ``accept``.
-``finite(state) -> bool``, ``scale(state) -> ndarray``
-    Whether every number of a state is finite (a stepper may also refuse a finite state it
-    knows to have diverged: the structural steppers' energy check,
-    :mod:`tumble.structural.divergence`; ``failure`` then says so); the magnitudes the
-    error is relative to.
 ``norm(error, old, new, control) -> float``
     The weighted size of a step's error estimate (by default Hairer's RMS norm,
-    :func:`~tumble.ode.control.error_norm`, over :meth:`~Stepper.scale`); a step is accepted
-    when it is at most 1. A stepper whose state has parts of different kinds (an attitude and
-    vectors) says here what the tolerances measure.
-``failure(t_old, t_new) -> str``
-    Why the step from ``t_old`` to ``t_new`` gave a state that is not finite (by default
-    :func:`non_finite_message`; an implicit stepper names its unconverged solve, a structural
-    one the energy that outgrew its bound).
+    :func:`~tumble.ode.control.error_norm`); a step is accepted when it is at most 1. A
+    stepper whose state has parts of different kinds (an attitude and vectors) says here
+    what the tolerances measure. ``error_order`` is the estimate's order ``q`` (the
+    controller's exponent is ``1/(q + 1)``).
 ``record(state) -> tuple of ndarray``
-    One sample: each array with a time axis of length 1 at :attr:`~Stepper.time_axis`.
-``march_block(state, grid, k0, k1, every, step0) -> Block`` (optional, ``blocks = True``)
-    Steps ``k0 + 1 … k1`` of a fixed grid at once, compiled, recording every ``every``-th
-    step: how the kernels keep their speed with no Python per step. ``Block.failed`` is the
-    step that failed (as ``finite`` would have refused it), the block's state the one before.
+    One sample: each array with a time axis of length 1 at ``time_axis`` (by default
+    ``(state[None],)`` and 0).
+
+The compiled part
+-----------------
+``Stepper.compiled`` is None, or a :class:`Compiled`: blocks of steps in compiled code, so a
+kernel runs thousands of steps per call with no Python per step. The driver asks it one
+question, :meth:`Compiled.takes`: does it march this run (adaptive or not, its steps followed
+by events, dense output or ``t_eval`` or not)? If so, the run marches in its blocks, else in
+Python steps. What the part gives:
+
+``march_block(state, grid, k0, k1, every, step0) -> Block``
+    Steps ``k0 + 1 … k1`` of a fixed grid at once, recording every step ``k`` with
+    ``step0 + k`` a multiple of ``every``. ``Block.failed`` is the step that failed (as
+    ``accept`` would have refused it), the block's state the one before, ``Block.message``
+    why if not a non-finite state. A block ends on a recorded step wherever one lies within
+    it (or at the grid's end), so that a loop which settles its state only where it records
+    or returns (the axes flow's merged half turns) gives the numbers of one block, as every
+    part must (the rigid ones go on from their loop's arrays, not packing again the state
+    they handed back).
 ``march_adaptive(state, t, t1, h, control, every, step0, max_steps) -> AdaptiveBlock``
-    (optional, ``adaptive_blocks = True``) Adaptive steps from ``t`` towards ``t1``, compiled,
-    with the same controller, norm and minimum step as :func:`march`; it returns at ``t1``,
-    at a failure, after ``max_steps`` steps, or when its record is full (then the driver
-    calls it again). ``h = 0`` asks it to choose the first step (``march(h=None)``).
-``block_interpolants`` : bool (optional, with ``blocks`` or ``adaptive_blocks``)
-    Whether each block also returns its accepted steps, ``Block.steps`` (:class:`Steps`:
-    every step's end, state and interpolant), so that runs with events, dense output or
-    ``t_eval`` march in blocks too. The driver follows each block's steps after it returns,
-    as it follows one Python step (events located on the interpolants by the same
-    :class:`~tumble.ode.events.EventTracker`, the interpolants kept, ``t_eval`` sampled);
-    with events a block takes at most :data:`EVENT_BLOCK` steps, so a terminal event costs
-    at most one block of steps beyond it. A terminal event in step ``i`` of a block cuts the
-    record there and ends the run at the event with the counters of that step, and the
-    driver calls ``rewind(block, i)`` so the stepper forgets what it counted for the
-    block's later steps. A stepper without it marches such runs in Python.
+    (optional) Adaptive steps from ``t`` towards ``t1``, with the same controller, norm and
+    minimum step as the driver; it returns at ``t1``, at a failure, after ``max_steps``
+    steps, or when its record is full (then the driver calls it again). ``h = 0`` asks it to
+    choose the first step (``march(h=None)``).
+``steps``, ``rewind(block, index)`` (optional)
+    With ``steps``, each block also returns its accepted steps, ``Block.steps``
+    (:class:`Steps`: every step's end, state and interpolant), so that runs with events,
+    dense output or ``t_eval`` march in blocks too. The driver follows each block's steps
+    after it returns, as it follows one Python step (events located on the interpolants by
+    the same :class:`~tumble.ode.events.EventTracker`, the interpolants kept, ``t_eval``
+    sampled); with events a block takes at most :data:`EVENT_BLOCK` steps, so a terminal
+    event costs at most one block of steps beyond it. A terminal event in step ``i`` of a
+    block cuts the record there and ends the run at the event with the counters of that
+    step, and ``rewind(block, i)`` lets the part forget what it counted for the later steps.
+``block_steps`` (optional)
+    At most this many steps per ``march_block`` call (memory, or Ctrl-C between blocks).
+
+Many members
+------------
+A stepper may march many independent members at once (the bodies of
+:func:`~tumble.rigid.simulate_batch`): its state and records carry the members first
+(``time_axis = 1``), and its blocks say in ``Block.stops`` (:class:`Stops`) which members
+stopped in them, at which step and why; such a member stops alone, its state left at its
+last finite one, which no later block marches. The driver keeps each member's account over
+the blocks and ends the run with ``Outcome.members`` (:class:`Members`): per member its
+status and message (its step named), its steps, its valid samples and their last time. In
+the record, a stopped member's last finite state follows its recorded samples (unless the
+last of them is that state) and its later rows are NaN. A block ends on a recorded step, so
+a batch gives the same numbers bit for bit in one block or in many.
 
 What :func:`march` guarantees
 -----------------------------
@@ -71,15 +92,16 @@ What :func:`march` guarantees
 * The record holds the initial state, every ``record_every``-th accepted step (counted over
   the whole run) and the final state; after a jump the state at the jump's time replaces the
   sample taken just before it.
-* A non-finite state ends the run with :attr:`Status.FAILED` and a message naming the step;
-  the record and the final state are the last finite ones.
+* A non-finite state, or a step the stepper refuses, ends the run with
+  :attr:`Status.FAILED` and a message naming the step; the record and the final state are
+  the last finite ones.
 * ``max_steps`` accepted steps end the run with :attr:`Status.FAILED`.
 * Events ``g(t, state)`` are located by :class:`~tumble.ode.events.EventTracker` on the
   stepper's interpolant; a terminal event ends the run there with
   :attr:`Status.TERMINAL_EVENT`.
 * With ``t_eval``, the record holds the state at exactly those times (each step's
   interpolant between the steps) instead of every ``record_every``-th step.
-* Compiled blocks give the run that Python steps would: the same steps, record, status,
+* A compiled part gives the run that Python steps would: the same steps, record, status,
   message, counters, events and interpolants.
 * ``progress(t)`` is called as the run goes (per block, per jump segment, every
   :data:`PROGRESS_EVERY` Python steps).
@@ -105,13 +127,16 @@ import numpy as np
 from tumble.ode.contract import (
     AdaptiveBlock,
     Block,
+    Compiled,
     Control,
     Grid,
     Jump,
+    Members,
     Outcome,
     Status,
     Stepper,
     Steps,
+    Stops,
     max_steps_message,
     non_finite_message,
 )
@@ -124,13 +149,16 @@ from tumble.ode.events import Event, EventTracker
 __all__ = [
     "AdaptiveBlock",
     "Block",
+    "Compiled",
     "Control",
     "Grid",
     "Jump",
+    "Members",
     "Outcome",
     "Status",
     "Stepper",
     "Steps",
+    "Stops",
     "check_record_size",
     "march",
     "max_steps_message",
@@ -141,7 +169,8 @@ PROGRESS_EVERY = 256
 """A Python-stepped run reports its progress every this many steps."""
 
 PROGRESS_BLOCKS = 50
-"""A compiled run with a progress bar marches in about this many blocks."""
+"""A compiled run with a progress bar marches in about this many blocks (at most one per
+recorded sample: each block a whole number of them)."""
 
 EVENT_BLOCK = 256
 """With events, a compiled block takes at most this many steps (a terminal event found after
@@ -176,6 +205,7 @@ class _Run:
         self.interpolants: list[Callable] | None = [] if dense else None
         self.times: list[np.ndarray] = []
         self.samples: list[tuple] = []
+        self.members: _Members | None = None
         self.t_eval, self.next_eval = t_eval, 0
         if t_eval is None or t_eval[0] == t0:
             self.record()
@@ -234,11 +264,9 @@ class _Run:
         return t_new, new
 
     def accept(self, t_old: float, old: Any, t_new: float, new: Any) -> bool:
-        """Take an accepted step; True when the run must stop (a terminal event)."""
-        stepper = self.stepper
-        stepper.accept(t_new, new)
+        """Take a step the stepper accepted; True when the run must stop (a terminal event)."""
         if self.tracker is not None or self.interpolants is not None or self.t_eval is not None:
-            sol = stepper.interpolant(t_old, old, t_new, new)
+            sol = self.stepper.interpolant(t_old, old, t_new, new)
             t_new, new = self.follow(t_old, t_new, new, sol)
         self.t, self.state = t_new, new
         self.n_steps += 1
@@ -247,6 +275,13 @@ class _Run:
         if self.progress is not None and self.n_steps % PROGRESS_EVERY == 0:
             self.progress(t_new)
         return self.status == Status.TERMINAL_EVENT
+
+    def stops(self, stops: Stops, grid: Grid, k0: int) -> None:
+        """Where members stopped in a block from grid step ``k0`` (the record and the
+        counters still at the block's start)."""
+        if self.members is None:
+            self.members = _Members(len(stops.failed), sum(len(t) for t in self.times))
+        self.members.stop(stops, grid, self.n_steps - k0)
 
     def outcome(self) -> Outcome:
         if self.t_eval is None and self.times[-1][-1] != self.t:
@@ -260,9 +295,14 @@ class _Run:
         records = tuple(
             np.concatenate(parts, axis=axis) for parts in zip(*self.samples, strict=True)
         )
+        t = np.concatenate(self.times)
+        members = None
+        if self.members is not None:
+            last = self.stepper.record(self.state)
+            members = self.members.outcome(self, t, records, last)
         tracker = self.tracker
         return Outcome(
-            t=np.concatenate(self.times),
+            t=t,
             records=records,
             state=self.state,
             status=self.status,
@@ -273,6 +313,48 @@ class _Run:
             y_events=tracker.y_events if tracker else [],
             step_times=self.step_times,
             interpolants=self.interpolants,
+            members=members,
+        )
+
+
+class _Members:
+    """Each member's account over a run's blocks (many members: module docstring)."""
+
+    def __init__(self, n: int, recorded: int):
+        self.recorded = np.full(n, recorded, dtype=np.int64)  # samples so far
+        self.n_steps = np.full(n, -1, dtype=np.int64)  # steps of a stopped member; -1: going
+        self.t_last = np.full(n, math.nan)  # the time of its last finite state
+        self.messages: dict[int, str] = {}
+
+    def stop(self, stops: Stops, grid: Grid, step0: int) -> None:
+        """A block's :class:`Stops`, on ``grid`` whose step ``k`` is the run's ``step0 + k``."""
+        self.recorded += stops.recorded
+        for k in np.flatnonzero(stops.failed >= 0).tolist():
+            step = int(stops.failed[k])
+            t_old, t_new = grid.time(step - 1), grid.time(step)
+            self.n_steps[k], self.t_last[k] = step0 + step - 1, t_old
+            self.messages[k] = stops.messages.get(k) or non_finite_message(t_old, t_new)
+
+    def outcome(self, run: _Run, t: np.ndarray, records: tuple, last: tuple) -> Members:
+        """The members' outcome; each stopped one's record ended in place: its last finite
+        state (``last``, a record of the run's state, which holds it) after its samples
+        unless the last of them is that state, NaN after."""
+        stopped = self.n_steps >= 0
+        n_recorded = np.where(stopped, self.recorded, len(t))
+        for k in np.flatnonzero(stopped).tolist():
+            row = int(n_recorded[k])
+            if t[row - 1] != self.t_last[k]:
+                for array, sample in zip(records, last, strict=True):
+                    array[k, row] = sample[k, 0]
+                n_recorded[k] += 1
+            for array in records:
+                array[k, n_recorded[k] :] = np.nan
+        return Members(
+            status=np.where(stopped, int(Status.FAILED), int(run.status)),
+            messages=[self.messages.get(k, run.message) for k in range(len(stopped))],
+            n_steps=np.where(stopped, self.n_steps, run.n_steps),
+            n_recorded=n_recorded,
+            t_last=np.where(stopped, self.t_last, run.t),
         )
 
 
@@ -285,8 +367,9 @@ def _fixed(run: _Run, t1: float, h: float) -> bool:
             return False
         t_old, old, t_new = run.t, run.state, grid.time(k)
         new, _ = stepper.step(t_old, old, t_new - t_old)
-        if not stepper.finite(new):
-            run.fail(stepper.failure(t_old, t_new))
+        refused = stepper.accept(t_old, old, t_new, new)
+        if refused is not None:
+            run.fail(refused)
             return False
         if run.accept(t_old, old, t_new, new):
             return False
@@ -321,30 +404,34 @@ def _adaptive(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, f
                 run.fail(_minimum_step_message(t_old, h_min, math.isfinite(norm)))
                 return False, h
             continue
-        if not stepper.finite(new):
-            run.fail(stepper.failure(t_old, t_new))
+        refused = stepper.accept(t_old, old, t_new, new)
+        if refused is not None:
+            run.fail(refused)
             return False, h
         if run.accept(t_old, old, t_new, new):
             return False, h
     return True, h
 
 
-def _adaptive_blocks(run: _Run, t1: float, h: float, control: Control) -> tuple[bool, float]:
-    """:func:`_adaptive` in the stepper's compiled blocks; (going on, the next step)."""
+def _adaptive_blocks(
+    run: _Run, part: Compiled, t1: float, h: float, control: Control
+) -> tuple[bool, float]:
+    """:func:`_adaptive` in the compiled ``part``'s blocks; (going on, the next step)."""
+    assert part.march_adaptive is not None
     while run.t < t1:
         allowed = run.max_steps - run.n_steps
         if run.tracker is not None:
             allowed = min(allowed, EVENT_BLOCK)
-        block = run.stepper.march_adaptive(
+        block = part.march_adaptive(
             run.state, run.t, t1, h, control, run.every, run.n_steps, allowed
         )
-        if not _take(run, block):
+        if not _take(run, part, block):
             return False, block.h
         run.n_steps += block.n_steps
         run.n_rejected += block.n_rejected
         run.t, run.state, h = block.t_end, block.state, block.h
         if block.failure == "non-finite":
-            run.fail(run.stepper.failure(run.t, block.t_failed))
+            run.fail(non_finite_message(run.t, block.t_failed))
             return False, h
         if block.failure == "minimum-step":
             run.fail(_minimum_step_message(run.t, minimum_step(run.t), block.finite))
@@ -357,7 +444,7 @@ def _adaptive_blocks(run: _Run, t1: float, h: float, control: Control) -> tuple[
     return True, h
 
 
-def _take(run: _Run, block: Block | AdaptiveBlock) -> bool:
+def _take(run: _Run, part: Compiled, block: Block | AdaptiveBlock) -> bool:
     """Keep a block's record and, if the run follows its steps (events, dense output,
     ``t_eval``), follow them: False when a terminal event ended the run in the block (the
     record is then cut there, the run stands at the event, with that step's counters)."""
@@ -373,13 +460,14 @@ def _take(run: _Run, block: Block | AdaptiveBlock) -> bool:
         if run.status == Status.TERMINAL_EVENT:
             kept = block.t < steps.t[i]
             axis = run.stepper.time_axis
-            cut = tuple(np.compress(kept, part, axis=axis) for part in block.records)
+            cut = tuple(np.compress(kept, array, axis=axis) for array in block.records)
             if run.t_eval is None:
                 run.extend(Block(block.t[kept], cut, new))
             run.n_steps += i + 1
             run.n_rejected += 0 if steps.n_rejected is None else int(steps.n_rejected[i])
             run.t, run.state = t_new, new
-            run.stepper.rewind(block, i)
+            if part.rewind is not None:
+                part.rewind(block, i)
             return False
         t_old = t_new
     if run.t_eval is None:
@@ -398,27 +486,45 @@ def _minimum_step_message(t: float, h_min: float, finite: bool) -> str:
     )
 
 
-def _blocks(run: _Run, t1: float, h: float) -> bool:
-    """March the grid from ``run.t`` to ``t1`` in compiled blocks; False when it ended."""
+def _block_end(k0: int, size: int, last: int, step0: int, every: int) -> int:
+    """Where a block from grid step ``k0`` ends: ``size`` steps on, at most at ``last``, and
+    back to the last recorded step within it (``step0 + k`` a multiple of ``every``) if there
+    is one, so that a loop which settles its state only where it records or returns (the
+    axes flow's merged half turns) gives the same numbers whatever the blocks."""
+    k1 = min(k0 + size, last)
+    recorded = k1 - (step0 + k1) % every
+    return recorded if k1 < last and recorded > k0 else k1
+
+
+def _blocks(run: _Run, part: Compiled, t1: float, h: float) -> bool:
+    """March the grid from ``run.t`` to ``t1`` in the compiled ``part``'s blocks; False
+    when the run ended."""
     grid = Grid(run.t, t1, h, fixed_step_count(run.t, t1, h))
     last = grid.n if run.max_steps - run.n_steps >= grid.n else int(run.max_steps) - run.n_steps
-    size = max(1, grid.n // PROGRESS_BLOCKS) if run.progress is not None else grid.n
-    size = min(size, run.stepper.block_steps or size)
+    size = grid.n
+    if run.progress is not None:  # whole recorded samples: blocks may end on recorded steps
+        size = min(size, -(-max(1, grid.n // PROGRESS_BLOCKS) // run.every) * run.every)
+    size = min(size, part.block_steps or size)
     if run.tracker is not None:
         size = min(size, EVENT_BLOCK)
-    for k0 in range(0, last, size):
-        k1 = min(k0 + size, last)
-        block = run.stepper.march_block(run.state, grid, k0, k1, run.every, run.n_steps - k0)
-        if not _take(run, block):
+    k0 = 0
+    while k0 < last:
+        step0 = run.n_steps - k0
+        k1 = _block_end(k0, size, last, step0, run.every)
+        block = part.march_block(run.state, grid, k0, k1, run.every, step0)
+        if block.stops is not None:
+            run.stops(block.stops, grid, k0)
+        if not _take(run, part, block):
             return False
         done = k1 if block.failed < 0 else block.failed - 1
         run.n_steps += done - k0
         run.t, run.state = grid.time(done), block.state
         if block.failed >= 0:
-            run.fail(run.stepper.failure(run.t, grid.time(block.failed)))
+            run.fail(block.message or non_finite_message(run.t, grid.time(block.failed)))
             return False
         if run.progress is not None:
             run.progress(run.t)
+        k0 = k1
     if last < grid.n:
         run.fail(run.max_steps_message())
         return False
@@ -510,8 +616,8 @@ def march(
     state : object
         The state at ``t0``, of the stepper's type.
     h : float or None
-        The fixed step, or an adaptive run's first step (None: the stepper's first compiled
-        adaptive block chooses it; only with ``adaptive_blocks``).
+        The fixed step, or an adaptive run's first step (None: the first block of the
+        stepper's compiled part chooses it; only with its ``march_adaptive``).
     control : Control, optional
         Tolerances and controller: the run is adaptive. None: fixed steps of ``h``.
     events : sequence of callables
@@ -547,10 +653,11 @@ def march(
     ([0.0, 0.5, 1.0], [1.0, 0.5625, 0.31640625], <Status.SUCCESS: 0>)
     """
     t0, t1 = t_span
-    blocked = not (events or dense_output or t_eval is not None) or stepper.block_interpolants
-    compiled = stepper.blocks and control is None and blocked
-    compiled_adaptive = stepper.adaptive_blocks and control is not None and blocked
-    if h is None and not compiled_adaptive:  # the caller chooses it and checks it
+    follows = bool(events) or dense_output or t_eval is not None
+    part = stepper.compiled
+    if part is not None and not part.takes(control is not None, follows):
+        part = None  # the run steps in Python
+    if h is None and (control is None or part is None):  # the caller chooses it, checks it
         raise TypeError("march needs h: the fixed step, or an adaptive run's first step")
     step = 0.0 if h is None else float(h)  # 0: the first compiled block chooses it
     limit = math.inf if max_steps is None else max_steps
@@ -561,15 +668,12 @@ def march(
     going = True
     for end, applied in _segments(t0, t1, jumps):
         if run.t < end:
-            if compiled_adaptive:
-                assert control is not None
-                going, step = _adaptive_blocks(run, end, step, control)
-            elif control is not None:
+            if control is None:
+                going = _fixed(run, end, step) if part is None else _blocks(run, part, end, step)
+            elif part is None:
                 going, step = _adaptive(run, end, step, control)
-            elif compiled:
-                going = _blocks(run, end, step)
             else:
-                going = _fixed(run, end, step)
+                going, step = _adaptive_blocks(run, part, end, step, control)
         if not going:
             break
         for apply in applied:

@@ -87,7 +87,8 @@ class RungeKutta(Stepper):
 
     def __init__(self, fun: Callable, tableau: ButcherTableau, t0: float, y0: np.ndarray):
         self.fun, self.tableau = fun, tableau
-        self.adaptive, self.error_order = tableau.adaptive, tableau.error_order
+        self.error_order = tableau.error_order
+        self._fsal = tableau.adaptive and tableau.fsal
         self.f = fun(t0, y0)
         self.f_old = self.f
         self.K = np.empty((tableau.stages, y0.size))
@@ -95,9 +96,14 @@ class RungeKutta(Stepper):
     def step(self, t: float, y: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray | None]:
         return rk_step(self.fun, t, y, self.f, h, self.tableau, self.K)
 
-    def accept(self, t: float, y: np.ndarray) -> None:
-        self.f_old = self.f
-        self.f = self.K[-1].copy() if self.adaptive and self.tableau.fsal else self.fun(t, y)
+    def accept(self, t_old: float, old: np.ndarray, t: float, y: np.ndarray) -> str | None:
+        """Keep ``f`` at the accepted point (``K[-1]`` for an FSAL pair, else one evaluation),
+        unless the state is not finite (refused, by default)."""
+        refused = super().accept(t_old, old, t, y)
+        if refused is None:
+            self.f_old = self.f
+            self.f = self.K[-1].copy() if self._fsal else self.fun(t, y)
+        return refused
 
     def interpolant(self, t_old, old, t_new, new) -> StepInterpolant:
         h = t_new - t_old
@@ -267,7 +273,7 @@ def solve(
     control = None
     if tableau.adaptive:
         control = Control(float(rtol), atol_array, _CONTROLLER)
-        if h is None and not stepper.adaptive_blocks:  # else the compiled loop chooses it
+        if h is None and not is_compiled(fun):  # else the compiled adaptive loop chooses it
             h = initial_step(counted, t0, y, stepper.f, tableau.error_order, rtol, atol_array)
     # Non-finite values are detected and reported as a status, not as numpy warnings.
     with np.errstate(over="ignore", invalid="ignore"):

@@ -1,6 +1,9 @@
-"""``simulate_batch``: many bodies (or many initial states of one body) in one compiled call.
+"""``simulate_batch``: many bodies (or many initial states of one body) in compiled calls.
 
-Body ``k`` of a batch has, bit for bit, the numbers of :func:`~tumble.rigid.simulate` run
+The batch is one stepper of the driver (:class:`BatchStepper`, a stepper of many members:
+:func:`~tumble.ode.driver.march` keeps each body's status, message, steps and last finite
+state, ``Outcome.members``), marched in blocks of steps that end on recorded steps. Body
+``k`` of a batch has, bit for bit, the numbers of :func:`~tumble.rigid.simulate` run
 alone with body ``k``'s arguments. The ``lie`` and ``quat`` methods (``rkmk4``, ``rk4-quat``,
 …) run batches of at least :data:`SOA_MIN_BODIES` bodies in the structure-of-arrays loops of
 :mod:`tumble.rigid.soa` (bodies as columns, vectorised, the one-body loop's numbers bit for
@@ -23,9 +26,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from tumble import _checks, so3
-from tumble._progress import announce_compilation
-from tumble.ode.control import fixed_step_count
-from tumble.ode.driver import Block, Grid, Status, Stepper, march, non_finite_message
+from tumble._progress import announce_compilation, progress_bar
+from tumble.ode.contract import UNCONVERGED
+from tumble.ode.driver import Block, Compiled, Grid, Status, Stepper, Stops, march
 from tumble.rigid import initial, overflow
 from tumble.rigid.body import RigidBody
 from tumble.rigid.forces import (
@@ -346,9 +349,14 @@ def _kernel_loads(forces, bodies):
     return (F, *compiled_loads(loads, bodies[0].mass)[1:])
 
 
-def record_times(grid: Grid, every: int) -> np.ndarray:
-    """The kernel's sample times ``t_old + h_k`` at steps ``every, 2 every, …`` (exactly)."""
-    k = np.arange(every, grid.n + 1, every)
+def record_times(
+    grid: Grid, every: int, k0: int = 0, k1: int | None = None, step0: int = 0
+) -> np.ndarray:
+    """The kernel's sample times ``t_old + h_k`` (exactly) at the recorded steps ``k`` of
+    ``k0 + 1 … k1``, those with ``step0 + k`` a multiple of ``every`` (by default the whole
+    grid's: steps ``every, 2 every, …``)."""
+    first = k0 + 1 + (-(step0 + k0 + 1)) % every
+    k = np.arange(first, (grid.n if k1 is None else k1) + 1, every)
     t_old = grid.t0 + (k - 1) * grid.h
     return t_old + (np.where(k == grid.n, grid.t1, grid.t0 + k * grid.h) - t_old)
 
@@ -369,8 +377,9 @@ def simulate_batch(
     forces: Sequence[Load | Impulse] = (),
     events: Sequence[Callable[[float, State], float]] = (),
     record_every: int = 1,
+    progress: bool = False,
 ) -> BatchTrajectory:
-    """Simulate ``N`` rigid bodies from ``t0`` to ``t_end`` in one compiled, parallel call.
+    """Simulate ``N`` rigid bodies from ``t0`` to ``t_end`` in compiled, parallel blocks.
 
     Each body obeys :func:`~tumble.rigid.simulate`'s equations,
 
@@ -414,6 +423,9 @@ def simulate_batch(
         Not supported (must be empty): use :func:`~tumble.rigid.simulate`.
     record_every : int
         Keep every k-th step (and the last), to bound memory.
+    progress : bool
+        Show a progress bar (rich): the batch then marches in about 50 blocks (the same
+        numbers, bit for bit, as in one).
 
     Returns
     -------
@@ -451,6 +463,7 @@ def simulate_batch(
     t0, t_end = initial.check_times(t0, t_end)
     h, _, _ = initial.check_steps(spec, h, None, None)
     every = initial.check_record_every(record_every)
+    progress = _checks.flag("progress", progress)
     if _checks.callables("events", events):
         raise _checks.fail(
             "events", events, "empty", remedy="simulate_batch locates no events: use simulate"
@@ -473,7 +486,7 @@ def simulate_batch(
     conservative = [load for load in for_body(split_loads(forces)[0], inertias)
                     if load.conservative]  # fmt: skip
     settings = {"h": h, "rtol": None, "atol": None, "record_every": every, "compiled": True}
-    batch = _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings)
+    batch = _run(spec, tuple(bodies), R, Y, loads, t0, t_end, h, every, settings, progress)
     if conservative:  # V for every body and sample at once (mass broadcast over time)
         masses = _per_body(batch.bodies, lambda body: body.mass)[:, None]
         batch.potential_energy = potential_energy(conservative, batch.x, batch.R, masses)
@@ -481,25 +494,39 @@ def simulate_batch(
 
 
 class BatchStepper(Stepper):
-    """Every body of a batch in the method's compiled batch loop, as one block of the driver.
+    """Every body of a batch in the method's compiled batch loop: a stepper of many members
+    (module docstring of :mod:`tumble.ode.driver`), with a compiled part and no Python step.
 
     The state is ``(attitude, Y)`` with a leading body axis; samples are stacked along axis 1
-    (time). A body whose state stops being finite stops alone: the block goes on for the
-    others, and :attr:`counts` and :attr:`failed` say, per body, how many samples it
-    recorded and at which step it stopped (-1: none); :attr:`causes` why
-    (:data:`~tumble.ode.contract.NON_FINITE` or ``UNCONVERGED``). The method's family
-    (:data:`~tumble.rigid.methods.FAMILIES`) gives the loop and the carried attitude:
-    ``split`` methods carry ``R_p = R P`` with each body's principal axes ``P``.
+    (time). A body whose state stops being finite stops alone: the blocks go on for the
+    others, each block's :class:`~tumble.ode.driver.Stops` say which bodies stopped in it, at
+    which step and why (a non-finite state, or an implicit flow that did not converge), and
+    the driver keeps each body's account (``Outcome.members``). :attr:`failed` remembers,
+    over the run, the step each body stopped before (-1: none), so that no later block
+    marches it. The method's family (:data:`~tumble.rigid.methods.FAMILIES`) gives the loop
+    and the carried attitude: ``split`` methods carry ``R_p = R P`` with each body's
+    principal axes ``P``. ``block_steps`` bounds the steps of one block; a block goes on
+    from the loops' own arrays ``(Z, R_N)`` when handed the state the last one returned
+    (packing it again would normalise a quaternion once more: the numbers would depend on
+    the blocks).
     """
 
-    blocks = True
     time_axis = 1
 
-    def __init__(self, method: Method, problem):
+    def __init__(self, method: Method, problem, block_steps: int | None = None):
         self.method, self.problem = method, problem
         self.family = FAMILIES[method.family]
         self.batch = self.family.batch_loop(method)
-        self.counts = self.failed = self.causes = np.zeros(0, dtype=np.int64)
+        n_bodies = len(problem.m)
+        self.failed = np.full(n_bodies, -1, dtype=np.int64)
+        self.causes = np.zeros(n_bodies, dtype=np.int64)
+        self._block_steps = block_steps
+        self._handed: tuple = (None, None)  # the state the last block handed back, its (Z, RN)
+
+    @property
+    def compiled(self) -> Compiled:
+        """The batch loop as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block, block_steps=self._block_steps)
 
     def start(self, state: tuple[np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """The stepped state for ``(R, Y)`` with a leading body axis."""
@@ -511,28 +538,35 @@ class BatchStepper(Stepper):
         q = attitude[:, None] if self.family.quaternion else np.empty((len(Y), 1, 0))
         return self.family.matrix(attitude, self.problem.axes)[:, None], Y[:, None], q
 
-    def march_block(self, state, grid: Grid, k0: int, k1: int, every: int, step0: int) -> Block:
+    def _march_block(self, state, grid: Grid, k0: int, k1: int, every: int, step0: int) -> Block:
         from tumble.rigid._compiled.base import Records
 
-        if (k0, k1, step0) != (0, grid.n, 0):
-            raise NotImplementedError("a batch marches its whole grid in one block")
-        n_bodies, size = len(state[1]), grid.n // every  # samples at steps every, 2 every, …
+        times = record_times(grid, every, k0, k1, step0)
+        n_bodies, size = len(state[1]), len(times)
         records = Records(*(np.empty((n_bodies, size, *shape)) for shape in RECORD_SHAPES))
-        self.counts, self.failed, self.causes = (np.zeros(n_bodies, dtype=np.int64)
-                                                 for _ in range(3))  # fmt: skip
-        Z, RN = self.family.pack(*state)
+        counts, before = np.zeros(n_bodies, dtype=np.int64), self.failed.copy()
+        Z, RN = self._handed[1] if state is self._handed[0] else self.family.pack(*state)
         if self.family.columns and n_bodies >= SOA_MIN_BODIES:
             _march_columns(self.method, self.family.quaternion, self.problem, grid, Z, RN,
-                           every, records, self.counts, self.failed)  # fmt: skip
+                           (k0, k1, every, step0), records, counts, self.failed)  # fmt: skip
         else:
             announce_compilation(self.batch, f"the batch loop of {self.method.name}")
-            self.batch(self.problem, grid, Z, RN, every, records, self.counts, self.failed,
-                       self.causes)  # fmt: skip
+            self.batch(self.problem, grid, Z, RN, k0, k1, every, step0, records, counts,
+                       self.failed, self.causes)  # fmt: skip
+        failed = np.where(before < 0, self.failed, -1)  # those that stopped in this block
+        messages = {
+            k: unconverged_message(self.method, grid.time(failed[k] - 1), grid.time(failed[k]))
+            for k in np.flatnonzero(failed >= 0).tolist()
+            if self.causes[k] == UNCONVERGED
+        }
         q = records.q if self.family.quaternion else np.empty((n_bodies, size, 0))
+        new = self.family.read(Z, RN)
+        self._handed = (new, (Z, RN))  # the next block goes on from them: not packed again
         return Block(
-            t=record_times(grid, every),
+            t=times,
             records=(records.R, records.Y, q),
-            state=self.family.read(Z, RN),
+            state=new,
+            stops=Stops(counts, failed, messages),
         )
 
 
@@ -547,23 +581,33 @@ more than the one-body loop (measured: one body 0.14× as fast in the columns, 1
 
 
 def _march_columns(
-    method: Method, quaternion: bool, problem, grid: Grid, Z, RN, every, records, counts, failed
-) -> None:
+    method: Method, quaternion: bool, problem, grid: Grid, Z, RN, steps: tuple, records,
+    counts, failed,
+) -> None:  # fmt: skip
     """:func:`tumble.rigid.soa.run_batch` on the batch's state ``Z`` (N, nz), ``RN``
-    (N, 3, 3), updated in place (its blocks turn their bodies into columns and back);
-    ``quaternion``: the chart carries q (else R)."""
+    (N, 3, 3), updated in place (its blocks turn their bodies into columns and back), over
+    ``steps = (k0, k1, every, step0)``; ``quaternion``: the chart carries q (else R)."""
     from tumble.rigid.soa import run_batch
 
     announce_compilation(run_batch, f"the batch loop of {method.name}")
-    run_batch(quaternion, problem, grid, Z, RN, every, records, counts, failed)
+    run_batch(quaternion, problem, grid, Z, RN, *steps, records, counts, failed)
 
 
 RECORD_SHAPES = ((), (3, 3), (4,), (9,))
 """Shapes of one sample in the kernels' ``Records``: t, R, q, Y."""
 
 
-def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTrajectory:
-    """Run the kernel for every body; lay the samples out as (body, time, …) arrays."""
+SAMPLE_BYTES = 8 * sum(int(np.prod(shape)) for shape in RECORD_SHAPES)
+"""Bytes of one body's sample in a block's ``Records``."""
+
+BLOCK_BYTES = 1 << 26
+"""A block's records take at most about this much (64 MiB; at least one sample of every
+body): a batch marches in blocks of that many steps, so that a long run needs its record
+and one block, not twice its record."""
+
+
+def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings, progress) -> BatchTrajectory:
+    """March every body (in blocks); lay the samples out as (body, time, …) arrays."""
     mass = _per_body(bodies, lambda body: body.mass)
     inv_I = _per_body(bodies, lambda body: body.inertia_inverse)
     family = FAMILIES[spec.family]
@@ -575,16 +619,16 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
         moments.setflags(write=False)
         axes.setflags(write=False)
     inertia = _per_body(bodies, lambda body: body.inertia)
-    stepper = BatchStepper(spec, problem(spec, inv_I, mass, loads, axes, moments, inertia))
-    out = march(stepper, (t0, t_end), stepper.start((R, Y)), h=h, record_every=every)
-    names = ("R", "Y", "q") if family.quaternion else ("R", "Y")
-    samples = dict(zip(names, out.records, strict=False))
-    last = {
-        name: record[:, 0] for name, record in zip(names, stepper.record(out.state), strict=False)
-    }
-    grid = Grid(t0, t_end, h, fixed_step_count(t0, t_end, h))
-    failed = stepper.failed
-    n_recorded, t_last = _end_stopped_bodies(samples, last, out.t, stepper.counts, failed, grid)
+    block = every * max(1, BLOCK_BYTES // (len(bodies) * SAMPLE_BYTES))
+    stepper = BatchStepper(spec, problem(spec, inv_I, mass, loads, axes, moments, inertia),
+                           block)  # fmt: skip
+    with progress_bar(progress, t_end - t0, "simulating") as update:
+        advance = (lambda t: update(completed=t - t0)) if progress else None
+        out = march(stepper, (t0, t_end), stepper.start((R, Y)), h=h, record_every=every,
+                    progress=advance)  # fmt: skip
+    samples = dict(zip(("R", "Y", "q"), out.records, strict=True))
+    members = out.members
+    assert members is not None
     Ys = samples["Y"]
     return BatchTrajectory(
         t=out.t,
@@ -595,49 +639,10 @@ def _run(spec, bodies, R, Y, loads, t0, t_end, h, every, settings) -> BatchTraje
         bodies=bodies,
         method=spec.name,
         settings=settings,
-        status=np.where(failed < 0, Status.SUCCESS, Status.FAILED),
-        messages=_messages(spec, failed, stepper.causes, grid),
-        n_steps=np.where(failed < 0, grid.n, failed - 1),
-        n_recorded=n_recorded,
-        q_raw=samples.get("q"),
-        t_last=t_last,
+        status=members.status,
+        messages=members.messages,
+        n_steps=members.n_steps,
+        n_recorded=members.n_recorded,
+        q_raw=samples["q"] if family.quaternion else None,
+        t_last=members.t_last,
     )
-
-
-def _end_stopped_bodies(samples, last, times, counts, failed, grid):
-    """Per body: how many samples are valid, and the time of the last one.
-
-    A stopped body keeps, as :func:`~tumble.rigid.simulate` does, its last finite state (left
-    in ``last`` by the kernel) as its last sample: in the row after its recorded ones, unless
-    the last recorded sample is that state already (same time). The rows after are NaN.
-    ``grid`` is the run's :class:`~tumble.ode.driver.Grid`.
-    """
-    n_recorded = np.full(len(failed), len(times))
-    t_last = np.full(len(failed), times[-1])
-    for k in np.flatnonzero(failed >= 0):
-        done = int(failed[k]) - 1  # steps completed
-        t_last[k] = grid.time(done)  # simulate's time of that state
-        n_recorded[k] = 1 + counts[k]
-        if times[counts[k]] != t_last[k]:
-            for name, array in samples.items():
-                array[k, n_recorded[k]] = last[name][k]
-            n_recorded[k] += 1
-        for array in samples.values():
-            array[k, n_recorded[k] :] = np.nan
-    return n_recorded, t_last
-
-
-def _messages(spec: Method, failed: np.ndarray, causes: np.ndarray, grid: Grid) -> list[str]:
-    """Per body, ``simulate``'s message: the end reached, the step that was not finite, or
-    the step whose implicit flow did not converge."""
-    from tumble.ode.contract import UNCONVERGED
-
-    messages = [Status.SUCCESS.message] * len(failed)
-    for k in np.flatnonzero(failed >= 0):
-        step = int(failed[k])
-        t_old, t_new = grid.time(step - 1), grid.time(step)
-        if causes[k] == UNCONVERGED:
-            messages[k] = unconverged_message(spec, t_old, t_new)
-        else:
-            messages[k] = non_finite_message(t_old, t_new)
-    return messages

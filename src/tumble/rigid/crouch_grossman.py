@@ -43,7 +43,7 @@ import numpy as np
 
 from tumble import so3
 from tumble._progress import announce_compilation
-from tumble.ode.driver import Block, Grid
+from tumble.ode.driver import Block, Compiled, Grid
 from tumble.ode.tableaux import ButcherTableau
 from tumble.rigid.charts import Dynamics
 from tumble.rigid.families import ANGULAR_MOMENTUM, ON_SO3
@@ -127,10 +127,8 @@ class CrouchGrossmanStepper(BodyStepper):
 
 
 class CompiledCrouchGrossmanStepper(CrouchGrossmanStepper):
-    """:class:`CrouchGrossmanStepper` whose fixed grids march in the compiled loop
-    (:data:`tumble.rigid._compiled.crouch_grossman.COMPILED_CG`)."""
-
-    blocks = True
+    """:class:`CrouchGrossmanStepper` with a compiled part: fixed grids march in the
+    compiled loop (:data:`tumble.rigid._compiled.crouch_grossman.COMPILED_CG`)."""
 
     def __init__(self, method: Method, dynamics: Dynamics, problem):
         from tumble.rigid._compiled.crouch_grossman import COMPILED_CG
@@ -138,7 +136,12 @@ class CompiledCrouchGrossmanStepper(CrouchGrossmanStepper):
         super().__init__(method, dynamics)
         self.problem, self.loop = problem, COMPILED_CG.loop
 
-    def march_block(
+    @property
+    def compiled(self) -> Compiled:
+        """The loop as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block)
+
+    def _march_block(
         self, state: RigidState, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
         records = _records((k1 - k0) // every + 1)

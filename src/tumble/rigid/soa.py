@@ -7,16 +7,17 @@ the ``lie`` and ``quat`` charts (``rkmk4``, ``rkmk8``, ``lie-euler``, ``seed-rk4
 :func:`run_batch` takes the batch as it is (``Z`` (N, nz), ``R_n`` (N, 3, 3), the body data
 in the :class:`~tumble.rigid._compiled.base.KernelProblem`) and each block of :data:`BLOCK`
 bodies copies its columns into contiguous work arrays (``z`` (nz, B), ``R_n`` (9, B),
-``I⁻¹`` (9, B), ``m`` (B,), ``F`` (3, B)), marches them over the whole grid and copies them
-back; the blocks run in parallel (``prange``), so the transposes do too. Each stage is a few
-loops over the bodies of the block whose bodies are plain arithmetic on contiguous rows, so
-LLVM turns them into packed (SIMD) instructions (``tests/rigid/test_rigid_batch.py`` checks
-the assembly for packed ``vmulpd``). What keeps them packed: no call and no branch in a loop
-over bodies (the rare branches run as a second, scalar loop after it), and few rows written
-per loop (a loop that also wrote the nine rows of the loads was judged not worth
-vectorising). What makes them cheap: a stage sum keeps up to four terms in a register
-(:func:`_combine`: one pass over the rows instead of one per term), the positions, which no
-field reads, get no stage sum, and the exp and dexp⁻¹ series take one loop for all bodies.
+``I⁻¹`` (9, B), ``m`` (B,), ``F`` (3, B)), marches them over the driver's block of steps
+and copies them back; the blocks run in parallel (``prange``), so the transposes do too.
+Each stage is a few loops over the bodies of the block whose bodies are plain arithmetic on
+contiguous rows, so LLVM turns them into packed (SIMD) instructions
+(``tests/rigid/test_rigid_batch.py`` checks the assembly for packed ``vmulpd``). What keeps
+them packed: no call and no branch in a loop over bodies (the rare branches run as a
+second, scalar loop after it), and few rows written per loop (a loop that also wrote the
+nine rows of the loads was judged not worth vectorising). What makes them cheap: a stage
+sum keeps up to four terms in a register (:func:`_combine`: one pass over the rows instead
+of one per term), the positions, which no field reads, get no stage sum, and the exp and
+dexp⁻¹ series take one loop for all bodies.
 
 The arithmetic is the one-body loop's, operation for operation in the same order
 (:func:`~tumble.rigid._compiled.charts._lie_field`, ``_quat_field``, ``_loads``, the stage
@@ -329,9 +330,11 @@ def _record(quat, z, Rn, j, R_out, q_out, Y_out):
 
 
 @njit(**_JIT)
-def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, failed):
+def _block(quat, problem, grid, z, Rn, inv_I, m, F, k0, k1, every, step0, j0, records, counts,
+           failed):  # fmt: skip
     """March the bodies ``j0 …`` of one block (their columns ``z``, ``Rn``, ``inv_I``, ``m``,
-    ``F``, contiguous) over the whole grid; the one-body loop's steps, body by body."""
+    ``F``, contiguous) over steps ``k0 + 1 … k1`` of the grid; the one-body loop's steps,
+    body by body (a body stopped before, ``failed[j] >= 0``, stays as it is)."""
     A, b, correct = problem.A, problem.b, problem.correct
     tau, points, point_forces = problem.tau, problem.points, problem.point_forces
     gravity = problem.gravity
@@ -344,8 +347,11 @@ def _block(quat, problem, grid, z, Rn, inv_I, m, F, every, j0, records, counts, 
     R, coefficients, bad = np.empty((9, n)), np.empty((3, n)), np.empty(n)
     alive, zero = np.ones(n, dtype=np.bool_), np.zeros((4, n))
     stage, state, swapped, dead = _terms(A, b), z, False, 0
-    count, until_record = 0, every
-    for k in range(1, n_steps + 1):
+    for j in range(n):
+        if failed[j0 + j] >= 0:
+            alive[j], dead = False, dead + 1
+    count, until_record = 0, every - (step0 + k0) % every
+    for k in range(k0 + 1, k1 + 1):
         t_old = t_a + (k - 1) * h
         hk = (t_b if k == n_steps else t_a + k * h) - t_old
         if quat:
@@ -412,13 +418,14 @@ def _columns(rows, j0, j1):
 
 
 @njit(parallel=True, **_JIT)
-def run_batch(quat, problem, grid, Z, RN, every, records, counts, failed):
-    """Every body of a batch, :data:`BLOCK` at a time in parallel: ``Z`` (N, nz), ``RN``
-    (N, 3, 3) (end as the last states), body ``k``'s data ``problem.inv_I[k]`` (3, 3),
-    ``problem.m[k]``, ``problem.F[k]`` (3,) and the shared loads (:class:`~tumble.rigid.
-    _compiled.base.KernelProblem`); each block works on its bodies as columns (copied in and out).
-    ``records``, ``counts``, ``failed`` as for :func:`~tumble.rigid._compiled.charts._batch` (the
-    cause of a stop is always ``NON_FINITE``)."""
+def run_batch(quat, problem, grid, Z, RN, k0, k1, every, step0, records, counts, failed):
+    """Steps ``k0 + 1 … k1`` of the grid for every body of a batch, :data:`BLOCK` at a time
+    in parallel: ``Z`` (N, nz), ``RN`` (N, 3, 3) (end as the last states), body ``k``'s data
+    ``problem.inv_I[k]`` (3, 3), ``problem.m[k]``, ``problem.F[k]`` (3,) and the shared loads
+    (:class:`~tumble.rigid._compiled.base.KernelProblem`); each block works on its bodies as
+    columns (copied in and out). ``records``, ``counts``, ``failed`` as for
+    :func:`~tumble.rigid._compiled.charts._batch` (the cause of a stop is always
+    ``NON_FINITE``)."""
     n_bodies = Z.shape[0]
     for block in prange((n_bodies + BLOCK - 1) // BLOCK):
         j0 = block * BLOCK
@@ -426,7 +433,8 @@ def run_batch(quat, problem, grid, Z, RN, every, records, counts, failed):
         z, Rn = _columns(Z, j0, j1), _columns(RN, j0, j1)
         m = np.ascontiguousarray(problem.m[j0:j1])
         _block(quat, problem, grid, z, Rn, _columns(problem.inv_I, j0, j1), m,
-               _columns(problem.F, j0, j1), every, j0, records, counts, failed)  # fmt: skip
+               _columns(problem.F, j0, j1), k0, k1, every, step0, j0, records, counts,
+               failed)  # fmt: skip
         for j in range(j1 - j0):
             for c in range(z.shape[0]):
                 Z[j0 + j, c] = z[c, j]

@@ -2,9 +2,10 @@
 
 :class:`RigidStepper` is the readable NumPy reference: one :func:`~tumble.ode.stepper.rk_step`
 of the method's tableau in the method's chart (:mod:`tumble.rigid.charts`).
-:class:`CompiledStepper` marches whole blocks of a fixed grid in the chart's numba loop
-(:mod:`tumble.rigid._compiled`), the same algorithm; ``tests/rigid`` checks they agree to
-round-off. Both plug into :func:`tumble.ode.driver.march`, which owns the time loop.
+:class:`CompiledStepper` adds a compiled part that marches whole blocks of a fixed grid in
+the chart's numba loop (:mod:`tumble.rigid._compiled`), the same algorithm;
+``tests/rigid`` checks they agree to round-off. Both plug into
+:func:`tumble.ode.driver.march`, which owns the time loop.
 
 :class:`SplitStepper` and :class:`CompiledSplitStepper` are the same pair for the ``split``
 family: one step of :func:`~tumble.rigid.geometric.split_step` in NumPy, and its compiled
@@ -12,7 +13,9 @@ loop. The method's family (:mod:`tumble.rigid.families`) chooses and builds them
 
 The stepped state is ``(attitude, Y)``: the chart's attitude (R, or q for the ``quat`` chart,
 or ``R_p = R P`` in the principal frame for the ``split`` family) and ``Y = (x, p, L)``,
-shape (9,).
+shape (9,). A compiled block goes on from the loop's own arrays ``(z, R_n)`` when it is
+handed the state the last block returned: packing that state again would normalise a
+quaternion once more, and the blocks' sizes would change the numbers.
 """
 
 from __future__ import annotations
@@ -24,9 +27,9 @@ import numpy as np
 
 from tumble import so3
 from tumble._progress import announce_compilation
-from tumble.ode.contract import FAILURES
+from tumble.ode.contract import FAILURES, UNCONVERGED
 from tumble.ode.dense import StepInterpolant, step_coefficients
-from tumble.ode.driver import AdaptiveBlock, Block, Control, Grid, Stepper, non_finite_message
+from tumble.ode.driver import AdaptiveBlock, Block, Compiled, Control, Grid, Stepper
 from tumble.ode.stepper import rk_step
 from tumble.rigid import geometric
 from tumble.rigid.charts import LIE, Chart, Dynamics, error_norm, separatrix_form
@@ -44,6 +47,10 @@ class BodyStepper(Stepper):
 
     _quat = False
     dynamics: Dynamics
+
+    def start(self, state: tuple[np.ndarray, np.ndarray]) -> RigidState:
+        """The stepped state for ``(R, Y)``: the attitude matrix and ``Y = (x, p, L)``."""
+        raise NotImplementedError
 
     def matrix(self, attitude: np.ndarray) -> np.ndarray:
         """R for the carried attitude."""
@@ -121,13 +128,16 @@ class RigidStepper(BodyStepper):
         self._last = (f, z, Rn, K, z_new, h)
         return chart.advance(z_new, Rn), error
 
-    def accept(self, t: float, state: RigidState) -> None:
+    def accept(self, t_old: float, old: RigidState, t_new: float, new: RigidState) -> str | None:
         """With a FSAL tableau keep the accepted step's last stage as the next one's first
-        (:attr:`~tumble.rigid.charts.Chart.first_same_as_last`): one evaluation saved."""
-        if self._fsal:
+        (:attr:`~tumble.rigid.charts.Chart.first_same_as_last`): one evaluation saved. A
+        state that is not finite is refused."""
+        refused = super().accept(t_old, old, t_new, new)
+        if refused is None and self._fsal:
             _, _, _, K, z_new, _ = self._last
             assert self.chart.first_same_as_last is not None
-            self._first = (state, self.chart.first_same_as_last(K, z_new))
+            self._first = (new, self.chart.first_same_as_last(K, z_new))
+        return refused
 
     def norm(self, error: np.ndarray, old: RigidState, new: RigidState, control: Control) -> float:
         """:func:`~tumble.rigid.charts.error_norm` of the last step: the attitude in radians
@@ -198,10 +208,12 @@ class SplitStepper(BodyStepper):
             return (np.full((3, 3), np.nan), np.full(9, np.nan)), None
         return new, None
 
-    def failure(self, t_old: float, t_new: float) -> str:
-        if self.unconverged:
+    def accept(self, t_old: float, old: RigidState, t_new: float, new: RigidState) -> str | None:
+        """A state that is not finite is refused; why, if a flow did not converge."""
+        refused = super().accept(t_old, old, t_new, new)
+        if refused is not None and self.unconverged:
             return unconverged_message(self.method, t_old, t_new)
-        return non_finite_message(t_old, t_new)
+        return refused
 
 
 def unconverged_message(method: Method, t_old: float, t_new: float) -> str:
@@ -218,14 +230,13 @@ ADAPTIVE_BLOCK = 4096
 
 
 class CompiledStepper(RigidStepper):
-    """:class:`RigidStepper` whose fixed grids march in the chart's compiled loop, and whose
-    adaptive steps (``rkmk45``, ``rkmk-dopri5``) run in the chart's compiled adaptive loop.
+    """:class:`RigidStepper` with a compiled part: fixed grids march in the chart's compiled
+    loop, and adaptive steps (``rkmk45``, ``rkmk-dopri5``) in the chart's compiled adaptive
+    loop.
 
     ``problem`` is the kernels' :class:`~tumble.rigid._compiled.base.KernelProblem` (constant
     loads).
     """
-
-    blocks = True
 
     def __init__(self, method: Method, chart: Chart, dynamics: Dynamics, problem):
         from tumble.rigid._compiled.charts import COMPILED
@@ -233,9 +244,15 @@ class CompiledStepper(RigidStepper):
         super().__init__(method, chart, dynamics)
         self.problem, self.loop = problem, COMPILED[self.chart.name].loop
         self.adaptive_loop = COMPILED[self.chart.name].adaptive
-        self.adaptive_blocks = method.adaptive and self.adaptive_loop is not None
+        self._adaptive = method.adaptive and self.adaptive_loop is not None
+        self._handed: tuple = (None, None)  # the state the last block handed back, its (z, Rn)
 
-    def march_adaptive(
+    @property
+    def compiled(self) -> Compiled:
+        """The chart's loops as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block, self._march_adaptive if self._adaptive else None)
+
+    def _march_adaptive(
         self, state: RigidState, t: float, t1: float, h: float, control: Control, every: int,
         step0: int, max_steps: float,
     ) -> AdaptiveBlock:  # fmt: skip
@@ -266,18 +283,20 @@ class CompiledStepper(RigidStepper):
             finite=finite,
         )
 
-    def march_block(
+    def _march_block(
         self, state: RigidState, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
         records = _records((k1 - k0) // every + 1)
-        z, Rn = self.chart.pack(*state)
+        z, Rn = self._handed[1] if state is self._handed[0] else self.chart.pack(*state)
         announce_compilation(self.loop, f"the {self.chart.name} chart's loop")
         count, failed, _ = self.loop(self.problem, grid, (z, Rn), k0, k1, every, step0, records)
         q = records.q[:count] if self._quat else np.empty((count, 0))
+        new = self.chart.read(z, Rn)
+        self._handed = (new, (z, Rn))  # the next block goes on from them (module docstring)
         return Block(
             t=records.t[:count],
             records=(records.R[:count], records.Y[:count], q),
-            state=self.chart.read(z, Rn),
+            state=new,
             failed=failed,
         )
 
@@ -290,9 +309,8 @@ def _records(size: int):
 
 
 class CompiledSplitStepper(SplitStepper):
-    """:class:`SplitStepper` whose fixed grids march in the flow's compiled ``split`` loop."""
-
-    blocks = True
+    """:class:`SplitStepper` with a compiled part: fixed grids march in the flow's compiled
+    ``split`` loop."""
 
     def __init__(self, method: Method, dynamics: Dynamics, problem):
         from tumble.rigid._compiled.flows import COMPILED_FLOWS
@@ -301,20 +319,26 @@ class CompiledSplitStepper(SplitStepper):
         assert method.flow is not None
         self.problem, self.loop = problem, COMPILED_FLOWS[method.flow].loop
 
-    def march_block(
+    @property
+    def compiled(self) -> Compiled:
+        """The flow's loop as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block)
+
+    def _march_block(
         self, state: RigidState, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
-        from tumble.ode.contract import UNCONVERGED
-
         records = _records((k1 - k0) // every + 1)
         Rp, Y = np.array(state[0], dtype=float), np.array(state[1], dtype=float)
         announce_compilation(self.loop, f"the {self.method.flow} flow's loop")
         count, failed, cause = self.loop(self.problem, grid, (Y, Rp), k0, k1, every, step0,
                                          records)  # fmt: skip
-        self.unconverged = failed >= 0 and cause == UNCONVERGED
+        message = None
+        if failed >= 0 and cause == UNCONVERGED:
+            message = unconverged_message(self.method, grid.time(failed - 1), grid.time(failed))
         return Block(
             t=records.t[:count],
             records=(records.R[:count], records.Y[:count], np.empty((count, 0))),
             state=(Rp, Y),
             failed=failed,
+            message=message,
         )

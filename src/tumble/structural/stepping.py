@@ -35,7 +35,7 @@ import scipy.sparse as sp
 from numpy.typing import NDArray
 
 from tumble._progress import announce_compilation
-from tumble.ode.driver import Block, Grid, Stepper, non_finite_message
+from tumble.ode.driver import Block, Compiled, Grid, Stepper, non_finite_message
 from tumble.structural.divergence import EnergyWatch, mechanical_energy
 from tumble.structural.factorization import BandedCholesky, factorize
 from tumble.structural.kernels import all_finite
@@ -108,13 +108,12 @@ def initial_state(
 class Watched(Stepper):
     """What both structural steppers share: the energy check of
     :mod:`tumble.structural.divergence` (:attr:`watch`, made from the initial state by
-    :meth:`start`) and the message of a run that failed it."""
+    :meth:`start`), whose message ends a run that fails it."""
 
     system: LinearSystem
     watch: EnergyWatch
     solve: Solve
     """``A⁻¹`` of the first step matrix (``A ≥ M``), for the watch's first bound."""
-    failed_check = False
 
     def start(self, state: BeamState, acceleration_energy: float = 0.0) -> BeamState:
         """The stepped state: ``state`` itself, and the watch from it (with
@@ -123,11 +122,6 @@ class Watched(Stepper):
             self.system, state.x, state.y, state.q, self.solve, acceleration_energy
         )
         return state
-
-    def failure(self, t_old: float, t_new: float) -> str:
-        if self.failed_check:
-            return self.watch.message(t_old, t_new)
-        return non_finite_message(t_old, t_new)
 
 
 class ReferenceBeamStepper(Watched):
@@ -152,15 +146,18 @@ class ReferenceBeamStepper(Watched):
         self.step_index = round((t + h) / self.dt)
         return new, None
 
-    def finite(self, state: BeamState) -> bool:
-        if not all_finite(state.x, state.y):
-            return False
+    def accept(self, t_old: float, old: BeamState, t_new: float, new: BeamState) -> str | None:
+        """A state that is not finite is refused, and so is one whose energy fails the
+        watch's check (at its steps)."""
+        if not all_finite(new.x, new.y):
+            return non_finite_message(t_old, t_new)
         if not self.watch.checks(self.step_index):
-            return True
+            return None
         t = self.step_index * self.dt
-        energy = mechanical_energy(self.system, state.x, state.y, state.q)
-        self.failed_check = self.watch.exceeds(t, energy) and self.watch.confirms(t, energy)
-        return not self.failed_check
+        energy = mechanical_energy(self.system, new.x, new.y, new.q)
+        if self.watch.exceeds(t, energy) and self.watch.confirms(t, energy):
+            return self.watch.message(t_old, t_new)
+        return None
 
     def record(self, state: BeamState) -> tuple:
         return state.x[None].copy(), state.y[None].copy()
@@ -168,8 +165,9 @@ class ReferenceBeamStepper(Watched):
 
 class CompiledBeamStepper(Watched):
     """Any scheme's compiled step in the one time loop
-    (:func:`~tumble.structural.kernels.time_loop`), as a stepper of the driver: blocks of
-    steps compiled, with the banded Cholesky factors of the scheme's step matrices.
+    (:func:`~tumble.structural.kernels.time_loop`), as a stepper of the driver with a
+    compiled part only: blocks of steps compiled, with the banded Cholesky factors of the
+    scheme's step matrices.
 
     Everything is put in the first factor's DOF order (``factor.order``) once, so the loop
     never permutes; :meth:`record` and the blocks' records put it back. A block that meets
@@ -178,8 +176,6 @@ class CompiledBeamStepper(Watched):
     no cost per step. A check that fails only the first bound (``P_A``, module
     :mod:`~tumble.structural.divergence`) goes on from where it stopped with the true one.
     """
-
-    blocks = True
 
     def __init__(
         self, system: LinearSystem, scheme: Scheme, C: sp.spmatrix | None, dt: float,
@@ -194,12 +190,17 @@ class CompiledBeamStepper(Watched):
         permuted_map = np.where(dof_map >= 0, self.inverse[np.maximum(dof_map, 0)], -1)
         self.frame = (permuted_map.astype(np.int32), *element_arrays)
         self.damping = _csr_arrays(None if C is None else sp.csr_matrix(C)[order][:, order])
-        self.block_steps = block
+        self._block = block
         self.system, self.solve = system, factors[0].solve
         self.kernel, self.what = scheme.kernel, f"the structural time loop ({scheme.name})"
         self.coefficients = scheme.coefficients(dt)
         self.work = tuple(np.zeros(order.size) for _ in range(self.kernel.work))
         self.lag = self.work[self.kernel.lag] if self.kernel.lag >= 0 else np.zeros(0)
+
+    @property
+    def compiled(self) -> Compiled:
+        """The time loop as the compiled part (made when asked: no reference cycle)."""
+        return Compiled(self._march_block, block_steps=self._block)
 
     def start(self, state: BeamState, acceleration_energy: float = 0.0) -> BeamState:
         """``state`` in the factor's DOF order, and the watch from it."""
@@ -217,7 +218,7 @@ class CompiledBeamStepper(Watched):
                     self.factors, self.damping, self.work, self.lag, self.checks, xs,
                     ys)  # fmt: skip
 
-    def march_block(
+    def _march_block(
         self, state: BeamState, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
         k = np.arange(k0 + 1, k1 + 1)
@@ -228,19 +229,22 @@ class CompiledBeamStepper(Watched):
         steps_padded = np.append(steps, -1)  # the loop reads one entry past its last record
         self.checks = self.watch.kernel(self.order)
         rows, failed, energy = self._run(state, k0, k1, steps_padded, 0, xs, ys)
+        diverged = False
         while failed >= 0 and not energy < 0:  # a failed energy check (-1.0: non-finite)
-            self.failed_check = self.watch.confirms(grid.time(failed), energy)
-            if self.failed_check:
+            diverged = self.watch.confirms(grid.time(failed), energy)
+            if diverged:
                 break
             self.checks = self.watch.kernel(self.order)  # the true bound holds: go on
             rows, failed, energy = self._run(state, failed, k1, steps_padded, rows, xs, ys)
+        message = None
         if failed >= 0:  # replay to the step before, from the block's start
             state, rows = start, int(np.searchsorted(steps, failed))
             self._run(state, k0, failed - 1, steps_padded, 0, xs, ys)
+            if diverged:
+                message = self.watch.message(grid.time(failed - 1), grid.time(failed))
         times = np.array([grid.time(int(step)) for step in steps[:rows]])
-        return Block(
-            times, (xs[:rows][:, self.inverse], ys[:rows][:, self.inverse]), state, failed
-        )
+        records = (xs[:rows][:, self.inverse], ys[:rows][:, self.inverse])
+        return Block(times, records, state, failed, message=message)
 
 
 def _kernel_factor(factor: BandedCholesky) -> tuple:

@@ -310,22 +310,24 @@ def _record(problem, state, records, i):
     RECORD(z, Rn, records.R[i], records.q[i], records.Y[i])  # noqa: F821
 
 
-def _batch(problem, grid, Z, RN, every, records, counts, failed, causes):
-    """:data:`LOOP` over all the steps of ``grid`` for every body ``k`` in parallel.
+def _batch(problem, grid, Z, RN, k0, k1, every, step0, records, counts, failed, causes):
+    """:data:`LOOP` over steps ``k0 + 1 … k1`` of ``grid`` for every body ``k`` in parallel.
 
     Body ``k``'s state is ``Z[k]`` (and ``RN[k]``), its data ``problem.inv_I[k]``,
     ``problem.m[k]``, ``problem.F[k]``, ``problem.axes[k]``, ``problem.moments[k]`` and
     ``problem.inertia[k]``; its samples go to ``records.t[k]``, … ; ``counts[k]`` samples,
-    the failed step ``failed[k]`` (-1 if none) and its cause ``causes[k]`` come back.
+    the failed step ``failed[k]`` (-1 if none) and its cause ``causes[k]`` come back. A body
+    stopped in an earlier block (``failed[k] >= 0`` on entry) is left as it is.
     """
     for k in prange(Z.shape[0]):
-        p = problem
-        body = KernelProblem(p.correct, p.A, p.b, p.inv_I[k], p.m[k], p.F[k], p.tau, p.points,
-                       p.point_forces, p.axes[k], p.moments[k], p.gravity,
-                       p.inertia[k])  # fmt: skip
-        body_records = Records(records.t[k], records.R[k], records.q[k], records.Y[k])
-        counts[k], failed[k], causes[k] = LOOP(body, grid, (Z[k], RN[k]), 0, grid.n, every,  # noqa: F821
-                                               0, body_records)  # fmt: skip
+        if failed[k] < 0:
+            p = problem
+            body = KernelProblem(p.correct, p.A, p.b, p.inv_I[k], p.m[k], p.F[k], p.tau,
+                                 p.points, p.point_forces, p.axes[k], p.moments[k], p.gravity,
+                                 p.inertia[k])  # fmt: skip
+            body_records = Records(records.t[k], records.R[k], records.q[k], records.Y[k])
+            counts[k], failed[k], causes[k] = LOOP(body, grid, (Z[k], RN[k]), k0, k1, every,  # noqa: F821
+                                                   step0, body_records)  # fmt: skip
 
 
 # The error norm is the Python reference's own function, compiled: the adaptive loop and
