@@ -413,8 +413,7 @@ class CompiledRungeKutta(RungeKutta):
         super().__init__(fun, tableau, t0, y0)
         self.compiled, self.tab = compiled, _tableau(tableau)
         self.adaptive_blocks, self.block_interpolants = tableau.adaptive, interpolants
-        self._problem = _new(SolveProblem, (compiled, self.tab.arrays, self.tab.hermite,
-                                            interpolants))  # fmt: skip
+        self._problem: SolveProblem | None = None  # the fixed loop's, at its first block
         self.f = np.array(self.f, dtype=float)  # updated in place by the loops
         self.size = FIRST_BLOCK
         self.compiled_evaluations = 0
@@ -427,6 +426,9 @@ class CompiledRungeKutta(RungeKutta):
         y = np.array(state, dtype=float)
         out = _arrays(k1 - k0, y.size, self.tab.q, self.block_interpolants, adaptive=False)
         grid_tuple = (float(grid.t0), float(grid.t1), float(grid.h), int(grid.n))
+        if self._problem is None:
+            self._problem = _new(SolveProblem, (self.compiled, self.tab.arrays, self.tab.hermite,
+                                                self.block_interpolants))  # fmt: skip
         count, failed, _ = _call(_FIXED, self.compiled, (
             self._problem, grid_tuple, (y, self.f), k0, k1, 1, 0, out))  # fmt: skip
         tab, start = self.tab, self.compiled_evaluations
@@ -502,8 +504,10 @@ class CompiledRungeKutta(RungeKutta):
             rule = control.controller
             settings = (float(rule.safety), float(rule.min_factor), float(rule.max_factor),
                         int(self.error_order), float(control.horizon or 0.0))  # fmt: skip
-            problem = _new(AdaptiveSolveProblem, (*self._problem, float(control.rtol), atol,
-                                                  settings[3], settings[4]))  # fmt: skip
+            tab = self.tab
+            problem = _new(AdaptiveSolveProblem, (self.compiled, tab.arrays, tab.hermite,
+                                                  self.block_interpolants, float(control.rtol),
+                                                  atol, settings[3], settings[4]))  # fmt: skip
             self._control = (control, problem, settings)
         return self._control[1], self._control[2]
 
