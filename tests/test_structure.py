@@ -154,3 +154,116 @@ def test_the_driver_reads_of_a_stepper_only_its_contract():
                 read[name].add(node.attr)
     assert read["stepper"] and read["stepper"] <= STEPPER, read["stepper"]
     assert read["part"] and read["part"] <= {*COMPILED_PART, "takes"}, read["part"]
+
+
+# The loops that advance time in compiled code (issue 25): the two templates of
+# tumble/ode/templates.py, which every family binds, and the batch's structure-of-arrays loop
+# (tumble/rigid/soa.py: bodies as SIMD columns, the declared exception).
+TIME_LOOPS = {("ode/templates.py", "fixed_loop"), ("ode/templates.py", "adaptive_loop"),
+              ("rigid/soa.py", "_block")}  # fmt: skip
+COMPILERS = {"njit", "jit", "bind", "loop", "time_loop"}  # also with a leading underscore
+"""Calls that compile a function or bind it into compiled code (their first argument)."""
+TIME_NAMES = {"t", "t_old", "t_new", "time"}
+"""Assigned inside a loop: the loop moves time on."""
+STEP_CALLS = {"STEP", "TRY", "GRID_TIME", "STEP_FACTOR", "MINIMUM_STEP_OF", "MINIMUM_STEP",
+              "grid_time", "step_factor", "minimum_step"}  # fmt: skip
+"""Called inside a loop (also with a leading underscore): a step, or the clock of one."""
+
+
+def _name(node: ast.AST) -> str:
+    """``f`` of ``f``, ``a.f`` and ``f(…)`` (a call that returns a compiler: ``njit(…)``)."""
+    if isinstance(node, ast.Call):
+        return _name(node.func)
+    if isinstance(node, ast.Attribute):
+        return node.attr
+    return node.id if isinstance(node, ast.Name) else ""
+
+
+def compiled_functions(files: list[Path]) -> set[str]:
+    """The names of the module-level functions that are compiled: decorated by ``njit``/
+    ``jit``, handed to a compiler or binder (:data:`COMPILERS`) or rebuilt from their
+    ``__code__`` anywhere in ``files``."""
+    names = set()
+    for path in files:
+        for node in ast.walk(_tree(path)):
+            if isinstance(node, ast.FunctionDef):
+                if any(_name(d) in {"njit", "jit"} for d in node.decorator_list):
+                    names.add(node.name)
+            elif isinstance(node, ast.Call) and node.args:
+                if _name(node.func).lstrip("_") in COMPILERS:
+                    names.add(_name(node.args[0]))
+            elif isinstance(node, ast.Attribute) and node.attr == "__code__":
+                names.add(_name(node.value))  # a function rebuilt from its code, to bind it
+    return names
+
+
+def _over_steps(loop: ast.For | ast.While) -> bool:
+    """``for k in range(k0 + 1, k1 + 1)``, ``range(1, n + 1)``: a loop over step numbers."""
+    call = loop.iter if isinstance(loop, ast.For) else None
+    if not (isinstance(call, ast.Call) and _name(call.func) == "range" and len(call.args) == 2):
+        return False
+    stop = call.args[1]
+    return (
+        isinstance(stop, ast.BinOp) and isinstance(stop.op, ast.Add)
+        and isinstance(stop.left, ast.Name | ast.Attribute)
+        and isinstance(stop.right, ast.Constant) and stop.right.value == 1
+    )  # fmt: skip
+
+
+def _advances_time(function: ast.FunctionDef) -> bool:
+    for loop in ast.walk(function):
+        if not isinstance(loop, ast.For | ast.While):
+            continue
+        if _over_steps(loop):
+            return True
+        for node in ast.walk(loop):
+            targets = node.targets if isinstance(node, ast.Assign) else (
+                [node.target] if isinstance(node, ast.AugAssign) else [])  # fmt: skip
+            names = {n.id for t in targets for n in ast.walk(t) if isinstance(n, ast.Name)}
+            if names & TIME_NAMES:
+                return True
+            if isinstance(node, ast.Call) and _name(node.func).lstrip("_") in STEP_CALLS:
+                return True
+    return False
+
+
+def time_loops(source: Path) -> set[tuple[str, str]]:
+    """``(file, function)`` of every compiled function under ``source`` with a loop that
+    advances time: a loop over step numbers (:func:`_over_steps`), or one that assigns a
+    time (:data:`TIME_NAMES`) or calls a step or its clock (:data:`STEP_CALLS`). Read from
+    the source, so a heuristic: it finds every such loop of the tree before issue 25 (9)
+    and after its first part (7), and the test below checks its forms."""
+    files = sorted(source.rglob("*.py"))
+    compiled = compiled_functions(files)
+    found = set()
+    for path in files:
+        for node in _tree(path).body:
+            if (
+                isinstance(node, ast.FunctionDef)
+                and node.name in compiled
+                and _advances_time(node)
+            ):
+                found.add((str(path.relative_to(source)), node.name))
+    return found
+
+
+def test_time_advances_in_compiled_code_only_in_the_templates_and_the_batch_loop():
+    """A family binds the templates (``templates.loop``); a new hand-written compiled time
+    loop fails here, by its file and name."""
+    assert time_loops(SOURCE) == TIME_LOOPS
+
+
+def test_the_time_loop_finder_finds_a_hand_written_loop(tmp_path):
+    (tmp_path / "family.py").write_text(
+        "from numba import njit\n\n"
+        "@njit\ndef _loop(y, h, n):\n    for k in range(n):\n        t_new = k * h\n"
+        "        y = STEP(y, t_new)\n    return y\n\n"
+        "def _step_loop(y, n):\n    for k in range(n):\n        y = STEP(y)\n    return y\n\n"
+        "LOOP = njit(bind(_step_loop, 'x', STEP=None))\n\n"
+        "@njit\ndef _steps(x, first, last):\n    for k in range(first + 1, last + 1):\n"
+        "        x = 2 * x\n    return x\n\n"
+        "@njit\ndef _band(x, p, b):\n    for j in range(1, min(p, b) + 1):\n        x += j\n"
+        "    return x\n\n"
+        "def python_loop(n):\n    for k in range(n):\n        t = k\n    return t\n"
+    )
+    assert time_loops(tmp_path) == {("family.py", n) for n in ("_loop", "_step_loop", "_steps")}

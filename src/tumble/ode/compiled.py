@@ -3,11 +3,11 @@
 When the right-hand side handed to :func:`tumble.solve` is a numba-compiled function (a
 ``CPUDispatcher``, made by ``@numba.njit``), the stepper :func:`tumble.ode.driver.march` runs
 is :class:`CompiledRungeKutta`: :class:`tumble.ode.ivp.RungeKutta` with a compiled part
-whose fixed grids (``march_block``, :func:`_fixed_loop`) and adaptive steps
-(``march_adaptive``, :func:`_adaptive_loop`) run in numba loops that call ``fun`` from
-compiled code, with no Python per step. Everything around the steps is the driver's, as
-for every stepper: the record, the status and its message, ``max_steps``, events, dense
-output. The loops are the
+whose fixed grids (``march_block``, :data:`_FIXED`) and adaptive steps (``march_adaptive``,
+:data:`_ADAPTIVE`) run in the loop templates of :mod:`tumble.ode.templates`, bound to the
+steps below, which call ``fun`` from compiled code, with no Python per step. Everything
+around the steps is the driver's, as for every stepper: the record, the status and its
+message, ``max_steps``, events, dense output. The loops are the
 Python stepper's algorithm and must give its result to round-off
 (``tests/ode/test_ode_compiled.py`` compares the two for every tableau of
 :data:`~tumble.ode.tableaux.TABLEAUX`):
@@ -30,14 +30,19 @@ Python stepper's algorithm and must give its result to round-off
   :class:`~tumble.ode.events.EventTracker` (the events may be compiled or not) and keeps
   them as the dense output.
 
-The loops take ``fun`` as an argument, so numba compiles them once per right-hand side and
-process (2 to 5 s here, ``benchmarks/bench_cold.py``): numba keys a function that receives
-another by that function's identity, so such a loop can never come from the on-disk cache
-(``cache=True`` would only add an index entry at each run). What they call is cached. After
-the first call a loop is called through its compiled entry point (about 1 µs instead of
-numba's 14 µs dispatch of a function argument). The few lines that call ``fun`` (the stages,
-the extension's extra stages) are written in each loop: a compiled helper that receives
-``fun`` calls it indirectly, which made the loops 1.3 to 2.5 times slower.
+The loops receive ``fun`` in their :class:`SolveProblem`, so numba compiles them once per
+right-hand side and process (2 to 5 s here, ``benchmarks/bench_cold.py``): numba keys a
+function that receives another by that function's identity, so such a loop can never come
+from the on-disk cache (``cache=False``; ``cache=True`` would only add an index entry at
+each run). What they call is cached. After the first call a loop is called through its
+compiled entry point (about 1 µs instead of numba's 14 µs dispatch of a function argument).
+The functions that call ``fun`` (:func:`_stages`, :func:`_extend`, the steps) are inlined
+into the loop, where ``fun`` is the problem's field, so each call is direct: a compiled
+helper not inlined, that received ``fun``, called it indirectly, which made the loops 1.3 to
+2.5 times slower; bound and inlined they take the hand-written loops' time
+(``benchmarks/bench_renovation.py``) and give their numbers bit for bit. The evaluations of
+``fun`` are counted from what the loops return: each part of a step makes a known number
+(:meth:`CompiledRungeKutta._count`).
 
 References
 ----------
@@ -51,32 +56,23 @@ import math
 import weakref
 from collections.abc import Callable
 from functools import cache
+from typing import NamedTuple
 
 import numba
 import numpy as np
 from numba import njit
 
-from tumble.ode import control
-from tumble.ode.contract import FAILURES, MINIMUM_STEP, NON_FINITE, OK
+from tumble.ode import control, templates
+from tumble.ode.contract import FAILURES, NON_FINITE, OK
 from tumble.ode.dense import StepInterpolant
 from tumble.ode.driver import AdaptiveBlock, Block, Compiled, Control, Grid, Steps
 from tumble.ode.ivp import RungeKutta
 from tumble.ode.tableaux import ButcherTableau
-from tumble.ode.templates import GRID_TIME as _GRID_TIME
 from tumble.ode.templates import INLINE as _INLINE
 from tumble.ode.templates import JIT as _JIT
-from tumble.ode.templates import MINIMUM_STEP_OF as _MINIMUM_STEP
-from tumble.ode.templates import STEP_FACTOR as _STEP_FACTOR
 
 FIRST_BLOCK, LARGEST_BLOCK = 256, 1 << 16
 """An adaptive block has room for this many steps, doubling at each block up to the second."""
-
-GOING = OK
-"""How an adaptive block ended, in the causes every compiled loop shares
-(:mod:`tumble.ode.contract`): ``GOING`` (``OK``: at ``t1``, its record full or ``max_steps``
-taken), ``NON_FINITE`` (a non-finite accepted state), ``MINIMUM_STEP`` (a step below the
-minimum); :data:`~tumble.ode.contract.FAILURES` names them for the
-:class:`~tumble.ode.driver.AdaptiveBlock`."""
 
 _INITIAL_STEP = njit(**_INLINE)(control.initial_step)
 
@@ -92,6 +88,7 @@ class Tableau:
 
     def __init__(self, tableau: ButcherTableau):
         s, m = tableau.stages, tableau.extra_stages
+        self.stages, self.extra_stages, self.fsal = s, m, tableau.fsal
         dense = tableau.dense
         self.hermite = dense is None
         self.q = 3 if dense is None else dense.shape[1]
@@ -148,13 +145,20 @@ def _norm(err, y, y_new, rtol, atol):
 
 
 @njit(**_JIT)
-def _hermite(y, y_new, f, f_new, h, Q):
-    """:func:`tumble.ode.dense.hermite_coefficients` into ``Q`` (n, 3)."""
+def _slopes(y, y_new, h, delta):
+    """``delta = (y_new − y)/h``: the secant slope the cubic Hermite interpolant takes."""
     for q in range(y.shape[0]):
-        delta = (y_new[q] - y[q]) / h
+        delta[q] = (y_new[q] - y[q]) / h
+
+
+@njit(**_JIT)
+def _hermite(delta, f, f_new, Q):
+    """:func:`tumble.ode.dense.hermite_coefficients` into ``Q`` (n, 3), from the slope
+    ``delta`` (:func:`_slopes`)."""
+    for q in range(delta.shape[0]):
         Q[q, 0] = f[q]
-        Q[q, 1] = 3 * delta - 2 * f[q] - f_new[q]
-        Q[q, 2] = f[q] + f_new[q] - 2 * delta
+        Q[q, 1] = 3 * delta[q] - 2 * f[q] - f_new[q]
+        Q[q, 2] = f[q] + f_new[q] - 2 * delta[q]
 
 
 @njit(**_JIT)
@@ -168,125 +172,190 @@ def _extension(X, P, Q):
             Q[q, col] = acc
 
 
-@njit(**_JIT)
-def _interpolant(tab, hermite, y, y_new, f_new, h, X, Q):
-    """The step's interpolant into ``Q`` (:func:`tumble.ode.dense.step_coefficients`): the
-    cubic Hermite one, or the continuous extension ``Xᵀ P`` from ``X``, the stages followed
-    by ``f_new = fun(t + h, y_new)`` and the extension's extra stages."""
-    if hermite:
-        _hermite(y, y_new, X[0], f_new, h, Q)
-    else:
-        _extension(X, tab[4], Q)
+class SolveProblem(NamedTuple):
+    """What ``solve``'s fixed-step loop needs besides the state: the compiled right-hand
+    side ``fun``, the tableau (:attr:`Tableau.arrays`), whether its interpolant is the cubic
+    Hermite one and whether the steps' interpolants are wanted (``want_q``)."""
+
+    fun: Callable
+    tab: tuple
+    hermite: bool
+    want_q: bool
 
 
-@njit(error_model="numpy")
-def _fixed_loop(fun, tab, hermite, want_q, grid, k0, k1, y, f, nfev, out):
-    """Steps ``k0 + 1 … k1`` of the fixed grid ``(t0, t1, h, n)``: the driver's ``_fixed``
-    with :class:`~tumble.ode.ivp.RungeKutta`.
+class AdaptiveSolveProblem(NamedTuple):
+    """:class:`SolveProblem` and what the adaptive loop needs more: the tolerances (``atol``
+    of shape (n,)), the order of the error estimate (for the first step) and the
+    controller's horizon (0: none)."""
 
-    ``y`` and ``f`` (``fun`` at ``y``) are updated in place; every accepted step is recorded
-    in ``out = (t, y, Q, nfev)`` (``Q`` when ``want_q``). Returns ``(count, failed, nfev)``:
-    ``failed`` is the grid step whose state was not finite (the block stops before it), or
-    -1; ``nfev`` counts on from the ``nfev`` given.
-    """
-    t0, t1, h, n_grid = grid
-    A, b, c, e, _, dense_A, dense_c = tab
-    ts, ys, Qs, nfevs = out
-    s, n, m = b.shape[0], y.shape[0], dense_c.shape[0]
-    X, z, y_new, err = np.empty((s + 1 + m, n)), np.empty(n), np.empty(n), np.empty(n)
-    for k in range(k0, k1):
-        t = _GRID_TIME(t0, t1, h, k, n_grid)
-        t_new = _GRID_TIME(t0, t1, h, k + 1, n_grid)
-        hk = t_new - t
-        X[0] = f
-        for i in range(1, s):  # k_i = f(t + c_i h, y + h Σ_{j<i} a_ij k_j)
-            _stage_point(A, i, i, y, hk, X, z)
-            X[i, :] = fun(t + c[i] * hk, z)
-        nfev += s - 1
-        if not _combine(b, e, y, hk, X, y_new, err):
-            return k - k0, k + 1, nfev
-        f[:] = fun(t_new, y_new)
-        nfev += 1
-        if want_q:
-            X[s] = f
-            for j in range(m):  # the continuous extension's extra stages
-                _stage_point(dense_A, j, s + 1 + j, y, hk, X, z)
-                X[s + 1 + j, :] = fun(t + dense_c[j] * hk, z)
-            nfev += m
-            _interpolant(tab, hermite, y, y_new, f, hk, X, Qs[k - k0])
-        y[:] = y_new
-        ts[k - k0], ys[k - k0], nfevs[k - k0] = t_new, y_new, nfev
-    return k1 - k0, -1, nfev
+    fun: Callable
+    tab: tuple
+    hermite: bool
+    want_q: bool
+    rtol: float
+    atol: np.ndarray
+    order: int
+    horizon: float
 
 
-@njit(error_model="numpy")
-def _adaptive_loop(fun, tab, flags, t, t1, h, rtol, atol, settings, y, f, nfev, max_steps,
-                   out):  # fmt: skip
-    """Adaptive steps from ``(t, y)`` towards ``t1``: the driver's ``_adaptive`` with
-    :class:`~tumble.ode.ivp.RungeKutta`, at most ``max_steps`` accepted ones.
+class SolveRecords(NamedTuple):
+    """Every accepted step of a block: its end ``t`` (m,), ``y`` (m, n), its interpolant's
+    ``Q`` (m, n, q) (none without ``want_q``), and in an adaptive block the tries rejected
+    in the block so far ``rejected`` (m,)."""
 
-    ``h <= 0`` asks for the first step (:func:`tumble.ode.control.initial_step`, compiled
-    from it). ``flags = (fsal, hermite, want_q)``; ``settings = (safety, min_factor,
-    max_factor, order, horizon)`` (``horizon`` 0: none, else :meth:`Control.weigh
-    <tumble.ode.driver.Control.weigh>`). ``y`` and ``f`` are updated in place; every accepted
-    step is recorded in ``out = (t, y, Q, nfev, rejected)``. Returns ``(count, t, h_next,
-    rejected, code, t_failed, norm_finite, nfev)``: ``code`` is :data:`GOING` (at ``t1``,
-    the record full or ``max_steps`` taken), :data:`NON_FINITE` (the step to ``t_failed``) or
-    :data:`MINIMUM_STEP` (``norm_finite``: whether its last norm was finite).
-    """
-    fsal, hermite, want_q = flags
-    safety, min_factor, max_factor, order, horizon = settings
-    ts, ys, Qs, nfevs, rejects = out
-    A, b, c, e, _, dense_A, dense_c = tab
-    s, n, m = b.shape[0], y.shape[0], dense_c.shape[0]
-    if h <= 0.0:  # the first step, chosen as solve's Python path does
-        h = _INITIAL_STEP(fun, t, y, f, order, rtol, atol)
-        nfev += 1
-    X, z, y_new, err = np.empty((s + 1 + m, n)), np.empty(n), np.empty(n), np.empty(n)
-    count, rejected, after_rejection = 0, 0, False
-    while t < t1 and count < ts.shape[0] and count < max_steps:
-        h_min = _MINIMUM_STEP(t)
-        planned = max(h, h_min)
-        t_new = min(t + planned, t1)
-        hk = t_new - t
-        X[0] = f
-        for i in range(1, s):  # the stages, as in _fixed_loop
-            _stage_point(A, i, i, y, hk, X, z)
-            X[i, :] = fun(t + c[i] * hk, z)
-        finite = _combine(b, e, y, hk, X, y_new, err)
-        nfev += s - 1
-        norm = _norm(err, y, y_new, rtol, atol)
-        if horizon > 0.0:
-            norm *= horizon / hk
-        h = hk * _STEP_FACTOR(norm, order, safety, min_factor, max_factor, after_rejection)
-        after_rejection = not norm <= 1.0
-        if after_rejection:
-            rejected += 1
-            if h < h_min:
-                return count, t, h, rejected, MINIMUM_STEP, t_new, math.isfinite(norm), nfev
-            continue
-        if t_new == t1 and t + planned > t1:
-            h = planned  # shortened to land on t1 (as the driver)
-        if not finite:
-            return count, t, h, rejected, NON_FINITE, t_new, True, nfev
-        if fsal:  # f at the new point: first same as last, or one evaluation
-            f[:] = X[s - 1]
+    t: np.ndarray
+    y: np.ndarray
+    Q: np.ndarray
+    rejected: np.ndarray
+
+
+# The loops are the templates of tumble.ode.templates bound to the functions below. The
+# state is (y, f): y and f = fun(t, y) of shape (n,); the work (X, z, y_new, err), and
+# (…, tally) in the adaptive loop: the stages X (s + 1 + m, n) (then f_new and the
+# extension's extra stages), a stage point z (then the Hermite slope), the new y and its
+# error, and the tries rejected with whether the last try was finite. Each part of a step
+# makes a known number of evaluations of fun, so the stepper counts them from what the
+# loops return (CompiledRungeKutta._count).
+
+
+@njit(**_INLINE)
+def _work(problem, state):
+    b, dense_c = problem.tab[1], problem.tab[6]
+    s, n, m = b.shape[0], state[0].shape[0], dense_c.shape[0]
+    return np.empty((s + 1 + m, n)), np.empty(n), np.empty(n), np.empty(n)
+
+
+@njit(**_INLINE)
+def _adaptive_work(problem, state):
+    return (*_work(problem, state), np.zeros(2, dtype=np.int64))
+
+
+@njit(**_INLINE)
+def _stages(problem, y, f, X, z, t, h):
+    """``k_0 = f`` and ``k_i = fun(t + c_i h, y + h Σ_{j<i} a_ij k_j)`` into ``X``; ``fun``
+    is called here, inlined into the loop, so that the call is direct."""
+    fun, A, c = problem.fun, problem.tab[0], problem.tab[2]
+    X[0] = f
+    for i in range(1, A.shape[0]):
+        _stage_point(A, i, i, y, h, X, z)
+        X[i, :] = fun(t + c[i] * h, z)
+
+
+@njit(**_INLINE)
+def _extend(problem, y, y_new, f_new, X, z, t, h):
+    """With ``want_q``, what the step's interpolant needs: ``X[s] = f_new``, then the
+    continuous extension's extra stages, or the Hermite slope into ``z``."""
+    if not problem.want_q:
+        return
+    fun, dense_A, dense_c = problem.fun, problem.tab[5], problem.tab[6]
+    s = problem.tab[1].shape[0]
+    X[s] = f_new
+    for j in range(dense_c.shape[0]):
+        _stage_point(dense_A, j, s + 1 + j, y, h, X, z)
+        X[s + 1 + j, :] = fun(t + dense_c[j] * h, z)
+    if problem.hermite:
+        _slopes(y, y_new, h, z)
+
+
+@njit(**_INLINE)
+def _adaptive_record(problem, state, work, records, i):
+    """:func:`_record` and the tries rejected so far."""
+    records.rejected[i] = work[4][0]
+    _record(problem, state, work, records, i)
+
+
+@njit(**_INLINE)
+def _record(problem, state, work, records, i):
+    """``y`` and, with ``want_q``, the interpolant's ``Q``
+    (:func:`tumble.ode.dense.step_coefficients`: the cubic Hermite one from ``f``, ``f_new``
+    and the slope, or the extension ``Xᵀ P`` of the stages)."""
+    y, f = state[0], state[1]
+    X, z = work[0], work[1]
+    records.y[i] = y
+    if problem.want_q:
+        if problem.hermite:
+            _hermite(z, X[0], f, records.Q[i])
         else:
-            f[:] = fun(t_new, y_new)
-            nfev += 1
-        if want_q:  # the interpolant, as in _fixed_loop
-            X[s] = f
-            for j in range(m):
-                _stage_point(dense_A, j, s + 1 + j, y, hk, X, z)
-                X[s + 1 + j, :] = fun(t + dense_c[j] * hk, z)
-            nfev += m
-            _interpolant(tab, hermite, y, y_new, f, hk, X, Qs[count])
-        y[:] = y_new
-        t = t_new
-        ts[count], ys[count] = t, y
-        nfevs[count], rejects[count] = nfev, rejected
-        count += 1
-    return count, t, h, rejected, GOING, t, True, nfev
+            _extension(X, problem.tab[4], records.Q[i])
+
+
+@njit(**_INLINE)
+def _fixed_step(problem, state, work, t, t_new, settle):
+    """One step of :func:`tumble.ode.stepper.rk_step` from ``t`` to ``t_new``, then ``f =
+    fun(t_new, y_new)`` and what the interpolant needs (:func:`_extend`); a non-finite
+    ``y_new`` leaves the state as it was (after s − 1 evaluations; s + m a step else)."""
+    b, e = problem.tab[1], problem.tab[3]
+    y, f = state
+    X, z, y_new, err = work
+    h = t_new - t
+    _stages(problem, y, f, X, z, t, h)
+    if not _combine(b, e, y, h, X, y_new, err):
+        return NON_FINITE
+    f[:] = problem.fun(t_new, y_new)
+    _extend(problem, y, y_new, f, X, z, t, h)
+    y[:] = y_new
+    return OK
+
+
+@njit(**_INLINE)
+def _try(problem, state, work, t, h, have_first, share):
+    """The step of :func:`_fixed_step` into ``y_new`` (the state untouched), its error norm
+    (:func:`tumble.ode.control.error_norm`, per unit step ``h/horizon`` with a horizon),
+    and the rejections counted in ``tally``."""
+    b, e = problem.tab[1], problem.tab[3]
+    y, f = state
+    X, z, y_new, err, tally = work
+    _stages(problem, y, f, X, z, t, h)
+    tally[1] = _combine(b, e, y, h, X, y_new, err)
+    norm = _norm(err, y, y_new, problem.rtol, problem.atol)
+    if problem.horizon > 0.0:
+        norm *= problem.horizon / h
+    if not norm <= 1.0:
+        tally[0] += 1
+    return norm
+
+
+@njit(**_INLINE)
+def _finite(problem, state, work):
+    return work[4][1] != 0
+
+
+@njit(**_INLINE)
+def _accept(problem, state, work, t, t_new, fsal):
+    """``y_new`` becomes ``y``, with ``f`` at it (the last stage if FSAL, else one
+    evaluation) and what the interpolant needs; each try computes its first stage."""
+    y, f = state
+    X, z, y_new = work[0], work[1], work[2]
+    s = problem.tab[1].shape[0]
+    if fsal:
+        f[:] = X[s - 1]
+    else:
+        f[:] = problem.fun(t_new, y_new)
+    _extend(problem, y, y_new, f, X, z, t, t_new - t)
+    y[:] = y_new
+    return False
+
+
+@njit(**_INLINE)
+def _first_step(problem, state, work, t):
+    """:func:`tumble.ode.control.initial_step` (one evaluation), as solve's Python path."""
+    y, f = state
+    return _INITIAL_STEP(problem.fun, t, y, f, problem.order, problem.rtol, problem.atol)
+
+
+_FIXED = templates.loop(
+    templates.fixed_loop, "_solve_fixed", cache=False, WORK=_work, STEP=_fixed_step,
+    RECORD=_record,
+)  # fmt: skip
+"""``solve``'s fixed grids: :func:`tumble.ode.templates.fixed_loop` with the steps above
+(compiled per right-hand side, ``cache=False``: module docstring)."""
+
+_ADAPTIVE = templates.loop(
+    templates.adaptive_loop, "_solve_adaptive", cache=False, WORK=_adaptive_work, TRY=_try,
+    FINITE=_finite, ACCEPT=_accept, FIRST_STEP=_first_step, RECORD=_adaptive_record,
+)  # fmt: skip
+"""``solve``'s adaptive steps: :func:`tumble.ode.templates.adaptive_loop` with the tries
+above."""
 
 
 _ENTRIES: dict[int, tuple[weakref.ref, dict]] = {}
@@ -294,14 +363,14 @@ _ENTRIES: dict[int, tuple[weakref.ref, dict]] = {}
 ``WeakKeyDictionary`` lookup makes a weak reference every call, 0.5 µs of a short run)."""
 
 
-def _call(loop, args: tuple) -> tuple:
-    """``loop(*args)`` through its compiled entry point once it is compiled for ``args[0]``.
+def _call(loop, fun: Callable, args: tuple) -> tuple:
+    """``loop(*args)`` through its compiled entry point once it is compiled for ``fun`` (in
+    ``args[0]``, the :class:`SolveProblem`).
 
     numba's dispatch of a function argument costs ~14 µs a call (it types the function each
     time); the entry point of the compiled overload costs ~1 µs. Every call of a loop passes
     arguments of the same types, so one overload per loop and ``fun`` is enough.
     """
-    fun = args[0]
     known = _ENTRIES.get(id(fun))
     if known is None or known[0]() is not fun:
         key = id(fun)
@@ -344,11 +413,12 @@ class CompiledRungeKutta(RungeKutta):
         super().__init__(fun, tableau, t0, y0)
         self.jitted, self.tab = compiled, _tableau(tableau)
         self.interpolants = interpolants
-        self._flags = (tableau.fsal, self.tab.hermite, interpolants)  # _adaptive_loop's
+        self._problem: SolveProblem | None = None  # the fixed loop's, at its first block
         self.f = np.array(self.f, dtype=float)  # updated in place by the loops
         self.size = FIRST_BLOCK
-        self._nfev: np.ndarray | None = None  # after each step of the last block
-        self._control: tuple = (None, None, None)  # (control, atol, settings)
+        self.compiled_evaluations = 0
+        self._counts: tuple = (0, 0, 0, _NONE)  # the last block's: _count
+        self._control: tuple = (None, None, None)  # (control, problem, settings)
 
     @property
     def compiled(self) -> Compiled:
@@ -362,10 +432,15 @@ class CompiledRungeKutta(RungeKutta):
         y = np.array(state, dtype=float)
         out = _arrays(k1 - k0, y.size, self.tab.q, self.interpolants, adaptive=False)
         grid_tuple = (float(grid.t0), float(grid.t1), float(grid.h), int(grid.n))
-        count, failed, self.compiled_evaluations = _call(_fixed_loop, (
-            self.jitted, self.tab.arrays, self.tab.hermite, self.interpolants,
-            grid_tuple, k0, k1, y, self.f, self.compiled_evaluations, out))  # fmt: skip
-        self._nfev = out[3]
+        if self._problem is None:
+            self._problem = _new(SolveProblem, (self.jitted, self.tab.arrays, self.tab.hermite,
+                                                self.interpolants))  # fmt: skip
+        count, failed, _ = _call(_FIXED, self.jitted, (
+            self._problem, grid_tuple, (y, self.f), k0, k1, 1, 0, out))  # fmt: skip
+        tab, start = self.tab, self.compiled_evaluations
+        per_step = tab.stages + (tab.extra_stages if self.interpolants else 0)
+        self._counts = (start, per_step, 0, _NONE)  # _count
+        self.compiled_evaluations = start + count * per_step + (tab.stages - 1) * (failed >= 0)
         every_th = slice((-(step0 + k0) - 1) % every, count, every)
         steps = self._steps(grid.time(k0), state, out, count)
         return Block(out[0][every_th], (out[1][every_th],), y, failed, steps)
@@ -378,12 +453,18 @@ class CompiledRungeKutta(RungeKutta):
         size = max(1, int(min(self.size, max_steps)))
         self.size = min(2 * self.size, LARGEST_BLOCK)
         out = _arrays(size, y.size, self.tab.q, self.interpolants, adaptive=True)
-        atol, settings = self._settings(control, y.size)
-        count, t_end, h_next, rejected, code, t_failed, finite, nfev = _call(_adaptive_loop, (
-            self.jitted, self.tab.arrays, self._flags, float(t), float(t1), float(h),
-            float(control.rtol), atol, settings, y, self.f, self.compiled_evaluations,
-            float(max_steps), out))  # fmt: skip
-        self.compiled_evaluations, self._nfev = nfev, out[3]
+        problem, settings = self._settings(control, y.size)
+        tab = self.tab
+        args = (problem, float(t), float(t1), float(h), settings, tab.fsal, (y, self.f), 1, 0,
+                float(max_steps), out)  # fmt: skip
+        count, t_end, h_next, _, rejected, code, t_failed, finite = _call(
+            _ADAPTIVE, self.jitted, args
+        )
+        accept = (0 if tab.fsal else 1) + (tab.extra_stages if self.interpolants else 0)
+        first = self.compiled_evaluations + (h <= 0.0)  # the first step's choice: one
+        self._counts = (first, accept, tab.stages - 1, out.rejected)
+        tries = count + rejected + (code == NON_FINITE)  # a non-finite try is no rejection
+        self.compiled_evaluations = first + count * accept + tries * (tab.stages - 1)
         every_th = slice((-step0 - 1) % every, count, every)
         steps = self._steps(t, state, out, count)
         return AdaptiveBlock(out[0][every_th], (out[1][every_th],), y, t_end, h_next, count,
@@ -391,10 +472,23 @@ class CompiledRungeKutta(RungeKutta):
 
     def _rewind(self, block: Block | AdaptiveBlock, index: int) -> None:
         """A terminal event in step ``index``: the evaluations counted stop with that step."""
-        assert self._nfev is not None
-        self.compiled_evaluations = int(self._nfev[index])
+        self.compiled_evaluations = self._count(index + 1)
 
-    def _steps(self, t: float, state: np.ndarray, out: tuple, count: int) -> Steps | None:
+    def _rejected(self, accepted: int) -> int:
+        """The tries of the last block rejected before its ``accepted``-th step."""
+        rejected = self._counts[3]
+        return int(rejected[accepted - 1]) if accepted and rejected.size else 0
+
+    def _count(self, accepted: int) -> int:
+        """The evaluations of ``fun`` after the last block's ``accepted``-th step: a known
+        number per accepted step (``s + m`` a fixed step, with ``m`` the extension's extra
+        stages when its interpolants are wanted; ``m`` and one for ``f`` unless FSAL an
+        adaptive one) and ``s − 1`` per try (rejected ones too), from the count at the
+        block's start (with one for the first step's choice)."""
+        start, per_step, per_try, _ = self._counts
+        return start + accepted * per_step + (accepted + self._rejected(accepted)) * per_try
+
+    def _steps(self, t: float, state: np.ndarray, out: SolveRecords, count: int) -> Steps | None:
         """The block's steps and their interpolants, with ``interpolants``."""
         if not self.interpolants:
             return None
@@ -405,22 +499,33 @@ class CompiledRungeKutta(RungeKutta):
             t_new = float(ts[i])
             interpolants.append(StepInterpolant(t_old, t_new - t_old, y_old, Qs[i]))
             t_old, y_old = t_new, ys[i]
-        return Steps(ts, ys, interpolants, out[4][:count] if len(out) == 5 else None)
+        return Steps(ts, ys, interpolants, out.rejected[:count] if out.rejected.size else None)
 
     def _settings(self, control: Control, n: int) -> tuple:
-        """``atol`` as an (n,) array and the controller's settings, kept for the run."""
+        """The adaptive loop's :class:`SolveProblem` (``atol`` as an (n,) array) and the
+        controller's settings, kept for the run."""
         if self._control[0] is not control:
             atol = np.array(control.atol, dtype=float)  # a number, or shape () or (n,)
             atol = np.full(n, atol) if atol.ndim == 0 else atol
             rule = control.controller
             settings = (float(rule.safety), float(rule.min_factor), float(rule.max_factor),
                         int(self.error_order), float(control.horizon or 0.0))  # fmt: skip
-            self._control = (control, atol, settings)
+            tab = self.tab
+            problem = _new(AdaptiveSolveProblem, (self.jitted, tab.arrays, tab.hermite,
+                                                  self.interpolants, float(control.rtol),
+                                                  atol, settings[3], settings[4]))  # fmt: skip
+            self._control = (control, problem, settings)
         return self._control[1], self._control[2]
 
 
-def _arrays(size: int, n: int, q: int, want_q: bool, *, adaptive: bool) -> tuple:
-    """A block's record: ``(t, y, Q, nfev)``, and the rejections for an adaptive one."""
-    arrays = (np.empty(size), np.empty((size, n)), np.empty((size if want_q else 0, n, q)),
-              np.empty(size, dtype=np.int64))  # fmt: skip
-    return (*arrays, np.empty(size, dtype=np.int64)) if adaptive else arrays
+_new = tuple.__new__
+"""A named tuple from a tuple without its ``__new__`` in Python (0.3 µs of a short call)."""
+_NONE = np.empty(0, dtype=np.int64)
+"""The rejections of a fixed block's record: none (never written)."""
+
+
+def _arrays(size: int, n: int, q: int, want_q: bool, *, adaptive: bool) -> SolveRecords:
+    """A block's :class:`SolveRecords` (the rejections for an adaptive one only)."""
+    rejected = np.empty(size, dtype=np.int64) if adaptive else _NONE
+    return _new(SolveRecords, (np.empty(size), np.empty((size, n)),
+                               np.empty((size if want_q else 0, n, q)), rejected))  # fmt: skip

@@ -8,13 +8,14 @@ per element. It takes each element's ``1/h``, ``EA/h`` and ``EI/h`` precomputed
 an element costs 3.4 ns instead of 4.7 ns (measured at 10⁴ elements).
 :func:`banded_solve` is the substitution with a banded Cholesky factor.
 
-**The one time loop.** :func:`_loop` advances every structural scheme: it calls the
-scheme's compiled step (a ``@numba.njit(inline="always")`` function, the twin of its NumPy
-reference step), watches the energy (:func:`watch_step`, every
-:data:`~tumble.structural.divergence.CHECK_EVERY` steps and at the last), records every
-requested step and stops at a non-finite state or a failed check. :func:`time_loop`
-compiles it once per step function, with the step inlined, under a name of its own (so
-numba's on-disk cache keeps each). A step function reads
+**The time loop** is the fixed-step template of :mod:`tumble.ode.templates`, which
+:func:`time_loop` binds once per step function, with the step inlined, under a name of its
+own (so numba's on-disk cache keeps each): the scheme's compiled step (a
+``@numba.njit(inline="always")`` function, the twin of its NumPy reference step) is its
+``STEP``, the energy watch (:func:`energy_exceeds`, every
+:data:`~tumble.structural.divergence.CHECK_EVERY` steps and at the last) its ``CHECK``; it
+records the requested steps and stops at a non-finite state or a failed check. A step
+function reads
 
 ``step(coefficients, state, frame, factors, damping, work) -> non_finite``
 
@@ -26,14 +27,16 @@ returns how many entries of ``x`` and ``y`` stopped being finite.
 
 from __future__ import annotations
 
-import types
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 import numba
 import numpy as np
 from numpy.typing import NDArray
+
+from tumble.ode import templates
+from tumble.ode.templates import NON_FINITE, OK
 
 
 @numba.njit(cache=True, nogil=True)
@@ -185,26 +188,6 @@ def energy_exceeds(
     return not energy <= limit, energy
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
-def watch_step(
-    k: int, until_check: int, non_finite: int, t: float, x: NDArray[np.float64],
-    y: NDArray[np.float64], q: NDArray[np.float64], lag: NDArray[np.float64], watch: tuple,
-) -> tuple[bool, float, int]:  # fmt: skip
-    """The energy check's cadence in every structural loop, after step ``k`` at ``t``: count
-    down ``until_check`` and, at zero or at the run's last step ``watch[1]``, ask
-    :func:`energy_exceeds` (not after a non-finite step, which stops the loop anyway).
-    Returns whether the run has diverged, ``V`` if so (else -1.0), and the next countdown."""
-    until_check -= 1
-    grown, energy = False, -1.0
-    if (until_check == 0 or k == watch[1]) and not non_finite:
-        grown, value = energy_exceeds(t, x, y, q, lag, watch)
-        if grown:
-            energy = value
-    if until_check == 0:
-        until_check = watch[0]
-    return grown, energy, until_check
-
-
 @numba.njit(cache=True, nogil=True, fastmath={"contract"})
 def banded_solve(
     forward: NDArray[np.float64],
@@ -242,98 +225,109 @@ def banded_solve(
         z = z[1:] + (acc,)
 
 
-def _loop(
-    first: int,
-    last: int,
-    record_steps: NDArray[np.int64],
-    row: int,
-    coefficients: tuple,
-    state: tuple,
-    frame: tuple,
-    factors: tuple,
-    damping: tuple,
-    work: tuple,
-    lag: NDArray[np.float64],
-    watch: tuple,
-    xs: NDArray[np.float64],
-    ys: NDArray[np.float64],
-) -> tuple[int, int, float]:
-    """Steps ``first + 1 … last`` of one scheme: ``STEP`` (bound by :func:`time_loop`), the
-    energy watch and the records.
+class BeamKernelProblem(NamedTuple):
+    """What a scheme's loop needs of a run besides its state (module docstring).
 
-    Parameters
-    ----------
-    first, last : int
-        Steps already taken, and the step to stop after.
-    record_steps : ndarray of int64, shape (n_records + 1,)
-        The steps to record, then one entry past the last (read, never recorded);
-        ``row`` is the next row of ``xs``, ``ys`` to fill.
-    coefficients : tuple of floats
-        The scheme's constants (:meth:`tumble.structural.scheme.Scheme.coefficients`),
-        ``Δt`` first.
-    state : tuple of ndarrays, shape (n,)
-        ``(x, y, q, …)``, the fields of the scheme's state, updated in place.
-    frame : tuple
-        ``(dof_map, 1/h, cos, sin, EA/h, EI/h)`` as in :func:`assemble_internal_forces`.
-    factors : tuple
-        ``(forward, backward, inverse_diagonal, window)`` of each step matrix, one bandwidth.
-    damping : tuple of 3 ndarrays
-        ``C`` as CSR ``(indptr, indices, data)``; ``indptr`` empty when undamped.
-    work : tuple of ndarrays, shape (n,)
-        The step's scratch vectors.
-    lag : ndarray, shape (n,) or (0,)
-        A step that leaves its ``S Δx`` to be taken from ``q`` by the next step (one pass
-        fewer) keeps it here (one of ``work``); the loop zeroes it first, hands it to the
-        watch and takes it from ``q`` at the end. Empty for the others.
-    watch : tuple
-        The energy check (:func:`energy_exceeds`), made after every step that is a multiple
-        of ``watch[0]`` and after step ``watch[1]`` (the run's last).
-    xs, ys : ndarray, shape (n_records, n)
-        Records of ``x`` and ``y``, filled from ``row``.
-
-    Returns
-    -------
-    row : int
-        The next row to fill.
-    diverged : int
-        The step at which the state became non-finite (recorded) or failed the energy check,
-        where the loop stopped; or -1.
-    energy : float
-        ``V`` at the failed check, or -1.0 (none failed: a non-finite state, or no stop).
+    ``coefficients``: the scheme's constants
+    (:meth:`tumble.structural.scheme.Scheme.coefficients`), ``Δt`` first; ``frame``:
+    ``(dof_map, 1/h, cos, sin, EA/h, EI/h)`` as in :func:`assemble_internal_forces`;
+    ``factors``: ``(forward, backward, inverse_diagonal, window)`` of each step matrix, one
+    bandwidth; ``damping``: ``C`` as CSR ``(indptr, indices, data)``, ``indptr`` empty when
+    undamped; ``work``: the step's scratch vectors; ``lag``: the ``S Δx`` a step leaves for
+    the next to take from ``q`` (one of ``work``), or empty; ``watch``: the energy check
+    (:func:`energy_exceeds`), made after every step that is a multiple of ``watch[0]`` and
+    after step ``watch[1]`` (the run's last); ``energy`` (1,): where a failed check leaves
+    its ``V`` (-1.0 before).
     """
+
+    coefficients: tuple
+    frame: tuple
+    factors: tuple
+    damping: tuple
+    work: tuple
+    lag: NDArray[np.float64]
+    watch: tuple
+    energy: NDArray[np.float64]
+
+
+class BeamRecords(NamedTuple):
+    """Where a scheme's loop writes its samples: ``t`` (m,), ``x`` and ``y`` (m, n)."""
+
+    t: NDArray[np.float64]
+    x: NDArray[np.float64]
+    y: NDArray[np.float64]
+
+    def after(self, rows: int) -> BeamRecords:
+        """The rows from ``rows`` on (a view), for a loop that goes on from there."""
+        return BeamRecords(self.t[rows:], self.x[rows:], self.y[rows:])
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _work(problem, state):  # noqa: ANN001, ANN202
+    """The step's scratch vectors; the lag starts at zero."""
+    lag = problem.lag
+    for i in range(lag.size):
+        lag[i] = 0.0
+    return problem.work
+
+
+def _step(problem, state, work, t, t_new, settle):  # noqa: ANN001, ANN202
+    """``KERNEL`` (the scheme's step, bound by :func:`time_loop`); :data:`NON_FINITE` when it
+    leaves ``x`` or ``y`` non-finite (the stepper replays the block to the step before)."""
+    p = problem
+    if KERNEL(p.coefficients, state, p.frame, p.factors, p.damping, work):  # type: ignore[name-defined]  # noqa: F821
+        return NON_FINITE
+    return OK
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _check(problem, state, work, k):  # noqa: ANN001, ANN202
+    """The energy watch after step ``k`` (every ``watch[0]`` steps and at ``watch[1]``, the
+    run's last): :func:`energy_exceeds` at ``t = k Δt``; a failed check leaves its ``V`` in
+    ``problem.energy`` and stops the loop as a divergence (:data:`NON_FINITE`, told from a
+    non-finite state by that ``V``)."""
+    watch = problem.watch
+    if k % watch[0] != 0 and k != watch[1]:
+        return OK
     x, y, q = state[0], state[1], state[2]
-    dt = coefficients[0]
-    diverged, energy = -1, -1.0
-    lag[:] = 0.0
-    until_check = watch[0] - first % watch[0]
-    for k in range(first + 1, last + 1):
-        non_finite = STEP(coefficients, state, frame, factors, damping, work)  # type: ignore[name-defined]  # noqa: F821
-        grown, energy, until_check = watch_step(k, until_check, non_finite, k * dt, x, y, q,
-                                                lag, watch)  # fmt: skip
-        if non_finite or k == record_steps[row]:
-            xs[row] = x
-            ys[row] = y
-            row += 1
-        if non_finite or grown:
-            diverged = k
-            break
+    grown, energy = energy_exceeds(k * problem.coefficients[0], x, y, q, problem.lag, watch)
+    if not grown:
+        return OK
+    problem.energy[0] = energy
+    return NON_FINITE
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _finish(problem, state, work):  # noqa: ANN001, ANN202
+    """The lag taken from ``q``: the state handed back is whole."""
+    q, lag = state[2], problem.lag
     for i in range(lag.size):
         q[i] -= lag[i]
-    return row, diverged, energy
 
 
-def time_loop(name: str, step: Callable[..., int]) -> Callable[..., tuple[int, int, float]]:
-    """:func:`_loop` compiled with ``step`` inlined, cached by numba under ``_loop_<name>``.
+@numba.njit(cache=True, nogil=True, inline="always")
+def _record(problem, state, work, records, i):  # noqa: ANN001, ANN202
+    records.x[i] = state[0]
+    records.y[i] = state[1]
 
-    numba's on-disk cache is keyed by a function's qualified name and code, so each step's
-    loop gets a name of its own; a closure over the step would miss the cache. The loop
-    compiles on its first call (once per bandwidth of the factors, whose ``window`` tuple
-    is part of the type).
+
+def time_loop(name: str, step: Callable[..., int]) -> Callable[..., tuple[int, int, int]]:
+    """The fixed-step template (:func:`tumble.ode.templates.fixed_loop`) bound to ``step``
+    and the watch, cached by numba under ``_beam_loop_<name>``.
+
+    It is called as ``loop(problem, grid, state, k0, k1, every, step0, records)`` with a
+    :class:`BeamKernelProblem`, the driver's :class:`~tumble.ode.driver.Grid`, the state's
+    vectors ``(x, y, q, …)`` and :class:`BeamRecords`, and returns ``(recorded, failed,
+    cause)``. The loop compiles on its first call (once per bandwidth of the factors, whose
+    ``window`` tuple is part of the type).
     """
-    bound = types.FunctionType(_loop.__code__, {**globals(), "STEP": step}, f"_loop_{name}")
-    bound.__qualname__ = f"_loop_{name}"
-    bound.__doc__ = _loop.__doc__
-    return numba.njit(cache=True, nogil=True)(bound)
+    bound = numba.njit(cache=True, nogil=True, inline="always")(
+        templates.bind(_step, f"_beam_step_{name}", KERNEL=step)
+    )
+    return templates.loop(
+        templates.fixed_loop, f"_beam_loop_{name}", nogil=True, WORK=_work, STEP=bound,
+        CHECK=_check, FINISH=_finish, RECORD=_record,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -343,8 +337,8 @@ class StepKernel:
     Attributes
     ----------
     name : str
-        Names the loop in numba's cache (``_loop_<name>``) and in the notice of its first
-        compilation.
+        Names the loop in numba's cache (``_beam_loop_<name>``) and in the notice of its
+        first compilation.
     step : callable
         ``step(coefficients, state, frame, factors, damping, work) -> non_finite``, a
         ``@numba.njit(inline="always")`` function.

@@ -38,7 +38,7 @@ from tumble._progress import announce_compilation
 from tumble.ode.driver import Block, Compiled, Grid, Stepper, non_finite_message
 from tumble.structural.divergence import EnergyWatch, mechanical_energy
 from tumble.structural.factorization import BandedCholesky, factorize
-from tumble.structural.kernels import all_finite
+from tumble.structural.kernels import BeamKernelProblem, BeamRecords, all_finite
 from tumble.structural.system import LinearSystem
 
 if TYPE_CHECKING:
@@ -196,6 +196,7 @@ class CompiledBeamStepper(Watched):
         self.coefficients = scheme.coefficients(dt)
         self.work = tuple(np.zeros(order.size) for _ in range(self.kernel.work))
         self.lag = self.work[self.kernel.lag] if self.kernel.lag >= 0 else np.zeros(0)
+        self.energy = np.full(1, -1.0)
 
     @property
     def compiled(self) -> Compiled:
@@ -210,41 +211,45 @@ class CompiledBeamStepper(Watched):
     def record(self, state: BeamState) -> tuple:
         return state.x[self.inverse][None], state.y[self.inverse][None]
 
-    def _run(self, state: BeamState, k0: int, k1: int, steps: NDArray[np.int64], row: int,
-             xs: NDArray, ys: NDArray) -> tuple[int, int, float]:  # fmt: skip
+    def _run(self, state: BeamState, grid: Grid, k0: int, k1: int, every: int, step0: int,
+             records: BeamRecords) -> tuple[int, int, float]:  # fmt: skip
+        """Steps ``k0 + 1 … k1`` in the loop: the rows recorded, the step where it stopped
+        (or -1) and ``V`` of a failed check (-1.0: a non-finite state, or none)."""
         loop = self.kernel.loop
         announce_compilation(loop, self.what)
-        return loop(k0, k1, steps, row, self.coefficients, state.vectors(), self.frame,
-                    self.factors, self.damping, self.work, self.lag, self.checks, xs,
-                    ys)  # fmt: skip
+        self.energy[0] = -1.0
+        problem = BeamKernelProblem(self.coefficients, self.frame, self.factors, self.damping,
+                                    self.work, self.lag, self.checks, self.energy)  # fmt: skip
+        rows, failed, _ = loop(problem, grid, state.vectors(), k0, k1, every, step0, records)
+        return rows, failed, float(self.energy[0])
 
     def _march_block(
         self, state: BeamState, grid: Grid, k0: int, k1: int, every: int, step0: int
     ) -> Block:
-        k = np.arange(k0 + 1, k1 + 1)
-        steps = k[(step0 + k) % every == 0]
+        first = k0 + 1 + (-(step0 + k0 + 1)) % every  # the first step recorded
+        size = max(0, (k1 - first) // every + 1)
         n = self.order.size
-        xs, ys = np.empty((steps.size + 1, n)), np.empty((steps.size + 1, n))
+        records = BeamRecords(np.empty(size), np.empty((size, n)), np.empty((size, n)))
         start = state.copy()
-        steps_padded = np.append(steps, -1)  # the loop reads one entry past its last record
         self.checks = self.watch.kernel(self.order)
-        rows, failed, energy = self._run(state, k0, k1, steps_padded, 0, xs, ys)
+        rows, failed, energy = self._run(state, grid, k0, k1, every, step0, records)
         diverged = False
         while failed >= 0 and not energy < 0:  # a failed energy check (-1.0: non-finite)
             diverged = self.watch.confirms(grid.time(failed), energy)
             if diverged:
                 break
             self.checks = self.watch.kernel(self.order)  # the true bound holds: go on
-            rows, failed, energy = self._run(state, failed, k1, steps_padded, rows, xs, ys)
+            more, failed, energy = self._run(state, grid, failed, k1, every, step0,
+                                             records.after(rows))  # fmt: skip
+            rows += more
         message = None
         if failed >= 0:  # replay to the step before, from the block's start
-            state, rows = start, int(np.searchsorted(steps, failed))
-            self._run(state, k0, failed - 1, steps_padded, 0, xs, ys)
+            state = start
+            rows, _, _ = self._run(state, grid, k0, failed - 1, every, step0, records)
             if diverged:
                 message = self.watch.message(grid.time(failed - 1), grid.time(failed))
-        times = np.array([grid.time(int(step)) for step in steps[:rows]])
-        records = (xs[:rows][:, self.inverse], ys[:rows][:, self.inverse])
-        return Block(times, records, state, failed, message=message)
+        xs, ys = records.x[:rows][:, self.inverse], records.y[:rows][:, self.inverse]
+        return Block(records.t[:rows], (xs, ys), state, failed, message=message)
 
 
 def _kernel_factor(factor: BandedCholesky) -> tuple:

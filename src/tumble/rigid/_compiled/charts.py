@@ -235,7 +235,7 @@ def _adaptive_work(problem, state):
     return _work(problem[0], state)
 
 
-def _step(problem, state, work, t, h, settle):
+def _step(problem, state, work, t, t_new, settle):
     """One explicit Runge–Kutta step of the chart's field (as :func:`tumble.ode.stepper.rk_step`)
 
     .. math:: k_i = f\\Bigl(z + h \\sum_{j<i} a_{ij} k_j\\Bigr), \\quad
@@ -248,7 +248,7 @@ def _step(problem, state, work, t, h, settle):
     """
     z, Rn = state
     K, zs, R, _ = work
-    b = problem.b
+    b, h = problem.b, t_new - t
     START(z, Rn)  # noqa: F821
     STAGES(problem, problem.A, z, Rn, h, 0, K, zs, R)  # noqa: F821
     finite = True
@@ -296,7 +296,7 @@ def _finite(problem, state, work):
     return True
 
 
-def _accept(problem, state, work, fsal):
+def _accept(problem, state, work, t, t_new, fsal):
     """The tried ``z`` becomes the state (``ADVANCE``); the last stage becomes the next
     try's first where the chart can (``FIRST_SAME_AS_LAST``)."""
     z, Rn = state
@@ -305,7 +305,7 @@ def _accept(problem, state, work, fsal):
     return fsal and FIRST_SAME_AS_LAST(K, K.shape[0], zs)  # noqa: F821
 
 
-def _record(problem, state, records, i):
+def _record(problem, state, work, records, i):
     z, Rn = state
     RECORD(z, Rn, records.R[i], records.q[i], records.Y[i])  # noqa: F821
 
@@ -354,8 +354,8 @@ def _for_chart(
     chart = dict(STAGES=stages, ADVANCE=advance, START=start)
     step = njit(**_INLINE)(bind(_step, f"_step_{name}", **chart))
     recorder = njit(**_INLINE)(bind(_record, f"_record_{name}", RECORD=record))
-    loop = njit(**_JIT)(
-        bind(templates.fixed_loop, f"_loop_{name}", WORK=_WORK, STEP=step, RECORD=recorder)
+    loop = templates.loop(
+        templates.fixed_loop, f"_loop_{name}", WORK=_WORK, STEP=step, RECORD=recorder
     )
     batch = njit(parallel=True, **_JIT)(bind(_batch, f"_batch_{name}", LOOP=loop))
     if not adaptive:  # the error norm is the lie chart's (every adaptive method is one)
@@ -364,11 +364,9 @@ def _for_chart(
     accept = njit(**_INLINE)(
         bind(_accept, f"_accept_{name}", ADVANCE=advance, FIRST_SAME_AS_LAST=fsal)
     )
-    adaptive_loop = njit(**_JIT)(
-        bind(
-            templates.adaptive_loop, f"_adaptive_{name}", WORK=_ADAPTIVE_WORK, TRY=tried,
-            FINITE=_finite, ACCEPT=accept, RECORD=recorder,
-        )
+    adaptive_loop = templates.loop(
+        templates.adaptive_loop, f"_adaptive_{name}", WORK=_ADAPTIVE_WORK, TRY=tried,
+        FINITE=_finite, ACCEPT=accept, RECORD=recorder,
     )  # fmt: skip
     return CompiledChart(loop, batch, adaptive_loop)
 

@@ -41,11 +41,11 @@ def _work(problem, state):
 
 
 @njit(**_INLINE)
-def _step(problem, state, work, t, h, settle):
+def _step(problem, state, work, t, t_new, settle):
     """:func:`tumble.rigid.crouch_grossman.cg_step` for constant loads, in place."""
     z, Rn = state
     K, W, zs, Ri = work
-    A, b = problem.A, problem.b
+    A, b, h = problem.A, problem.b, t_new - t
     s = b.shape[0]
     for i in range(s):
         _copy_matrix(Rn, Ri)
@@ -80,16 +80,14 @@ def _step(problem, state, work, t, h, settle):
 
 
 @njit(**_INLINE)
-def _record(problem, state, records, i):
+def _record(problem, state, work, records, i):
     z, Rn = state
     _copy_matrix(Rn, records.R[i])
     _copy(z, 0, records.Y[i])
 
 
 def _compile() -> CompiledChart:
-    loop = njit(**_JIT)(
-        bind(templates.fixed_loop, "_cg_loop", WORK=_work, STEP=_step, RECORD=_record)
-    )
+    loop = templates.loop(templates.fixed_loop, "_cg_loop", WORK=_work, STEP=_step, RECORD=_record)
     batch = njit(parallel=True, **_JIT)(bind(_batch, "_batch_cg", LOOP=loop))
     return CompiledChart(loop, batch)
 
