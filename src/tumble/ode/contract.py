@@ -101,7 +101,7 @@ class Steps:
     ----------
     t : ndarray, shape (m,)
         Where each step ends (the block starts where the run stands).
-    states : sequence
+    states : sequence or ndarray
         The state at each ``t``.
     interpolants : sequence of callable
         ``sol(t)`` on each step (as :meth:`Stepper.interpolant`).
@@ -110,7 +110,7 @@ class Steps:
     """
 
     t: np.ndarray
-    states: Sequence[Any]
+    states: Sequence[Any] | np.ndarray
     interpolants: Sequence[Callable]
     n_rejected: np.ndarray | None = None
 

@@ -275,7 +275,7 @@ def _step(problem, state, work, t, t_new, settle):  # noqa: ANN001, ANN202
     """``KERNEL`` (the scheme's step, bound by :func:`time_loop`); :data:`NON_FINITE` when it
     leaves ``x`` or ``y`` non-finite (the stepper replays the block to the step before)."""
     p = problem
-    if KERNEL(p.coefficients, state, p.frame, p.factors, p.damping, work):  # type: ignore[name-defined]  # noqa: F821
+    if KERNEL(p.coefficients, state, p.frame, p.factors, p.damping, work):  # noqa: F821
         return NON_FINITE
     return OK
 
