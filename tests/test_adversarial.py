@@ -43,6 +43,7 @@ from tumble import Status, exact, io, mass, meshes, ode, so3, structural
 from tumble.rigid import (
     Force,
     Gravity,
+    GravityGradient,
     Impulse,
     MagneticDipole,
     RigidBody,
@@ -51,6 +52,7 @@ from tumble.rigid import (
     simulate,
     simulate_batch,
 )
+from tumble.rigid.forces import State
 
 NAN, INF = math.nan, math.inf
 SOURCE = str(Path(tumble.__file__).parent)
@@ -700,6 +702,32 @@ each(
     {"inf": [0, INF, 0], "object": THING},
     lambda v: MagneticDipole((1.0, 0, 0), v),
 )
+each(
+    "GravityGradient",
+    "mu",
+    {"nan": NAN, "zero": 0.0, "negative": -1.0, "inf": INF, "str": "x"},
+    lambda v: GravityGradient(mu=v),
+)
+each(
+    "GravityGradient",
+    "centre",
+    {"nan": [NAN, 0, 0], "2-vector": [1, 2], "object": THING},
+    lambda v: GravityGradient(centre=v),
+)
+each(
+    "GravityGradient",
+    "inertia",
+    {"nan": [NAN, 1, 1], "negative": [-1.0, 1, 1], "2-vector": [1, 2], "not symmetric":
+     [[1, 0.5, 0], [0, 1, 0], [0, 0, 1]]},
+    lambda v: GravityGradient(inertia=v),
+)  # fmt: skip
+row(
+    "GravityGradient",
+    "called without an inertia",
+    lambda: GravityGradient()(0.0, State(np.array([7e6, 0, 0]), np.eye(3), np.zeros(3),
+                                         np.zeros(3)), 1.0),
+    Refused("GravityGradient.inertia"),
+)  # fmt: skip
 
 # ---------------------------------------------------------------------------------- so3
 

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 import os
+import signal
 import tempfile
 import threading
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from os import PathLike
 from pathlib import Path
 
@@ -45,26 +47,48 @@ def atomic_write(path: str | PathLike[str], writer: Callable[[Path], object]) ->
     if path in active:
         writer(path)  # already the temporary of an outer atomic_write
         return path
-    try:
-        handle, name = tempfile.mkstemp(
-            dir=path.parent, prefix=f".{path.stem}.", suffix=f"{PARTIAL}{path.suffix}"
-        )
-    except OSError as error:
-        raise ValueError(
-            f"cannot write {str(path)!r}: {error.strerror or error} (its folder must exist and "
-            "be writable)"
-        ) from None
-    os.close(handle)
-    tmp = Path(name)
-    active.add(tmp)
+    with _signals_held():  # a Ctrl-C between mkstemp and the try below would leave the file
+        try:
+            handle, name = tempfile.mkstemp(
+                dir=path.parent, prefix=f".{path.stem}.", suffix=f"{PARTIAL}{path.suffix}"
+            )
+        except OSError as error:
+            raise ValueError(
+                f"cannot write {str(path)!r}: {error.strerror or error} (its folder must exist "
+                "and be writable)"
+            ) from None
+        os.close(handle)
+        tmp = Path(name)
+        active.add(tmp)
     try:
         writer(tmp)
         os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     finally:
-        active.discard(tmp)
-        tmp.unlink(missing_ok=True)
+        with _signals_held():
+            active.discard(tmp)
+            tmp.unlink(missing_ok=True)
     return path
+
+
+_HELD = {signal.SIGINT, signal.SIGTERM}
+
+
+@contextmanager
+def _signals_held() -> Iterator[None]:
+    """Ctrl-C and SIGTERM wait (blocked, then delivered) while the block runs, in the main
+    thread on POSIX; elsewhere the block runs as it is."""
+    held = (
+        hasattr(signal, "pthread_sigmask")
+        and threading.current_thread() is threading.main_thread()
+    )
+    if held:
+        before = signal.pthread_sigmask(signal.SIG_BLOCK, _HELD)
+    try:
+        yield
+    finally:
+        if held:
+            signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def stale_partials(folder: Path) -> Iterator[Path]:

@@ -280,3 +280,25 @@ def test_a_load_key_the_type_does_not_take_is_named_with_the_allowed_ones():
     with pytest.raises(ValueError, match=r"loads\[0\]\.feild is not a key of a "
                        r"magnetic-dipole load; allowed: field, moment, type"):  # fmt: skip
         rigid_body.run(body=BOX, loads=[needle])
+
+
+def test_a_gravity_gradient_in_a_file_is_the_library_load_with_the_body_inertia():
+    """A cubesat on a circular orbit: the file's gravity-gradient load is
+    GravityGradient(mu) given the body's inertia by simulate, bit for bit; the file takes no
+    inertia key (the body's is the one that must be used) and refuses a mu <= 0."""
+    from tumble.rigid import GravityGradient, simulate
+    from tumble.scenarios.loads import SECTIONS
+
+    assert "inertia" not in SECTIONS["gravity-gradient"].model_fields
+    r, mu = 7.0e6, 3.986004418e14
+    initial = {"x0": [r, 0.0, 0.0], "v0": [0.0, (mu / r) ** 0.5, 0.0], "omega0": [0.01, 0.0, 0.02]}
+    load = {"type": "gravity-gradient", "mu": mu}
+    result = rigid_body.run(body=BOX, initial=initial, loads=[load], t_end=10.0, h=1.0)
+    trajectory = result.data["trajectory"]
+    alone = simulate(trajectory.body, 10.0, h=1.0, x0=initial["x0"], v0=initial["v0"],
+                     omega0=initial["omega0"], forces=[GravityGradient(mu=mu)])  # fmt: skip
+    assert np.array_equal(trajectory.R, alone.R)
+    assert np.array_equal(trajectory.x, alone.x)
+    assert result.summary["conserved"] == {"energy": True, "angular_momentum": False}
+    with pytest.raises(ValueError, match="mu"):
+        rigid_body.run(body=BOX, initial=initial, loads=[{**load, "mu": -1.0}], t_end=1.0, h=1.0)

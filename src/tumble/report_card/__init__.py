@@ -47,6 +47,7 @@ from __future__ import annotations
 
 import os
 import time
+import warnings
 from collections.abc import Sequence
 
 from tumble import _checks
@@ -207,10 +208,12 @@ def report(
             times, note = first_call_times(names, separate=not quick)
             first.update(times)
             update(advance=1)
-        for row in chosen:
-            update(description=f"report card: {row.name}")
-            results.append(measure_row(row, tests, references, long_t, repeat, first))
-            update(advance=1)
+        with warnings.catch_warnings():  # coarse steps on purpose: their errors are measured
+            warnings.simplefilter("ignore", _checks.LargeStepWarning)
+            for row in chosen:
+                update(description=f"report card: {row.name}")
+                results.append(measure_row(row, tests, references, long_t, repeat, first))
+                update(advance=1)
         update(description="report card: structural schemes")
         structural_table, setup = structural_rows(quick) if structural else ([], {})
         update(advance=1)

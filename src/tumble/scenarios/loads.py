@@ -27,8 +27,8 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from pydantic import create_model
 
-from tumble.rigid import Force, Gravity, Impulse, MagneticDipole, Torque
-from tumble.scenarios.schema import NonNegative, Number, Section, Vector3
+from tumble.rigid import Force, Gravity, GravityGradient, Impulse, MagneticDipole, Torque
+from tumble.scenarios.schema import NonNegative, Number, Positive, Section, Vector3
 
 KINDS: dict[str, Any] = {
     "Vector": Vector3,
@@ -59,12 +59,16 @@ class LoadRow:
     torque_free : callable
         ``torque_free(load)``: whether the built load exerts no torque about the centre of
         mass (then it leaves the angular momentum constant).
+    from_body : tuple of str
+        Fields the file does not give: left at their default, ``simulate`` fills them from
+        the body (the inertia of a gravity gradient).
     """
 
     load: type
     body_points: tuple[str, ...] = ()
     kinds: Mapping[str, Any] = field(default_factory=dict)
     torque_free: Callable[[Any], bool] = _turns
+    from_body: tuple[str, ...] = ()
 
 
 LOADS: dict[str, LoadRow] = {
@@ -73,6 +77,7 @@ LOADS: dict[str, LoadRow] = {
     "torque": LoadRow(Torque),
     "magnetic-dipole": LoadRow(MagneticDipole),
     "impulse": LoadRow(Impulse, kinds={"time": NonNegative}, torque_free=lambda load: False),
+    "gravity-gradient": LoadRow(GravityGradient, kinds={"mu": Positive}, from_body=("inertia",)),
 }
 """Every load type of the scenario files, by its ``type``."""
 
@@ -96,6 +101,8 @@ def section(name: str, row: LoadRow) -> type[LoadSection]:
     """The checked table of load ``name``: ``type`` and the fields of ``row.load``."""
     fields: dict[str, Any] = {"type": (Literal[name], ...)}
     for item in dataclasses.fields(row.load):
+        if item.name in row.from_body:
+            continue
         kind = row.kinds.get(item.name) or KINDS.get(str(item.type))
         if kind is None:
             raise TypeError(

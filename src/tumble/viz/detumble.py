@@ -34,7 +34,7 @@ def detumble_figure(
     period: float,
     title: str,
 ) -> None:
-    """|ω|, the commanded dipole and the attitude of a detumbling run (module docstring).
+    """``|ω|``, the commanded dipole and the attitude of a detumbling run (module docstring).
 
     Parameters
     ----------
