@@ -273,14 +273,14 @@ class GravityGradient:
     Examples
     --------
     A dumbbell-like body along world x, its centre of mass on the x axis: no torque (it
-    points at the centre), and the force is Kepler's, a little stronger:
+    points at the centre), and the force is Kepler's (-0.25) and the gradient term (-0.1875):
 
     >>> import numpy as np
     >>> load = GravityGradient(mu=1.0, inertia=(0.0001, 1.0, 1.0))
     >>> F, tau = load(0.0, State(np.array([2.0, 0.0, 0.0]), np.eye(3), np.zeros(3),
     ...                           np.zeros(3)), 1.0)
     >>> tau.tolist(), round(float(F[0]), 6)
-    ([0.0, 0.0, 0.0], -0.297)
+    ([0.0, 0.0, 0.0], -0.437481)
     """
 
     mu: float = GM_EARTH
