@@ -396,6 +396,16 @@ def memory() -> float:
         return 16.0 * 2**30
 
 
+def _byte_size(count: float) -> str:
+    """Bytes in binary units, as the size checks print them: ``_byte_size(3 * 2**30)`` is
+    ``'3 GiB'``."""
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
+        if count < 1024 or unit == "PiB":
+            return f"{count:.3g} {unit}"
+        count /= 1024
+    raise AssertionError  # pragma: no cover - the loop always returns
+
+
 def sample_times(name: str, value: ArrayLike, t0: float, t1: float) -> NDArray[np.float64]:
     """``value`` as a 1-D float array of times, sorted (increasing) and within ``[t0, t1]``:
     where a run is asked to sample its dense output (``t_eval``).

@@ -117,13 +117,12 @@ References
 from __future__ import annotations
 
 import math
-import os
 from collections.abc import Callable, Sequence
-from functools import cache
 from typing import Any
 
 import numpy as np
 
+from tumble import _checks
 from tumble.ode.contract import (
     AdaptiveBlock,
     Block,
@@ -553,8 +552,8 @@ def check_record_size(
         return
     message = (
         f"h={h!r} over {span!r} s would record {samples:.3g} samples of {per_sample} bytes "
-        f"({_bytes(need)}), more than the {_bytes(allowed)} (half of this machine's memory) "
-        "that a record may take"
+        f"({_checks._byte_size(need)}), more than the {_checks._byte_size(allowed)} (half of "
+        "this machine's memory) that a record may take"
     )
     if steps > 1e13:  # a week of steps at 0.1 µs each: the step, not the record, is wrong
         raise ValueError(f"{message}; {steps:.3g} steps would never finish: raise h")
@@ -565,21 +564,7 @@ def check_record_size(
     )
 
 
-@cache
-def _memory() -> float:
-    """This machine's physical memory in bytes (16 GiB if the system does not say)."""
-    try:
-        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
-    except (ValueError, OSError, AttributeError):
-        return 16.0 * 2**30
-
-
-def _bytes(count: float) -> str:
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
-        if count < 1024 or unit == "PiB":
-            return f"{count:.3g} {unit}"
-        count /= 1024
-    raise AssertionError  # pragma: no cover - the loop always returns
+_memory = _checks.memory  # this machine's memory (bytes); a module name tests can set
 
 
 def _segments(t0: float, t1: float, jumps: Sequence[Jump]) -> list[tuple[float, list]]:

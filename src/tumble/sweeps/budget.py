@@ -22,6 +22,7 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
+from tumble._checks import _byte_size as size
 from tumble.sweeps.plan import RIGID, Plan
 from tumble.sweeps.variables import VARIABLES, WALL_TIME, member_bytes
 
@@ -190,15 +191,6 @@ def machine_memory() -> float:
     from distributed.system import MEMORY_LIMIT
 
     return float(MEMORY_LIMIT)
-
-
-def size(count: float) -> str:
-    """Bytes in binary units: ``size(3 * 2**30)`` is ``'3 GiB'``."""
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
-        if count < 1024 or unit == "PiB":
-            return f"{count:.3g} {unit}"
-        count /= 1024
-    raise AssertionError  # pragma: no cover - the loop always returns
 
 
 def store_path(store: object) -> Path:
