@@ -96,7 +96,7 @@ def skipped_peers(peers: bool = True) -> dict[str, str]:
     """The peer rows :func:`rows` leaves out, each with why (MuJoCo or heyoka not installed)."""
     if not peers:
         return {}
-    skipped = {}
+    skipped: dict[str, str] = {}
     if not mujoco_available():
         why = (
             "not installed: rows skipped (MuJoCo is in the bench extra: pip install -e '.[bench]')"
