@@ -29,6 +29,7 @@ BENCHMARKS = [
     "bench_adaptive",
     "bench_geometric",
     "bench_published",
+    "bench_heyoka",
     "bench_structural",
     "bench_ode",
     "bench_import",

@@ -219,6 +219,7 @@ def test_peers_that_are_not_installed_are_said_skipped(tmp_path, monkeypatch):
     from tumble.report_card import peers
 
     monkeypatch.setattr(peers, "mujoco_available", lambda: False)
+    monkeypatch.setattr(peers, "heyoka_available", lambda: False)
     names = [row.name for row in report_card.rows(["rkmk4"])]
     assert names == ["rkmk4", "scipy DOP853", "scipy RK45"]
     # the card of one method, with the peers' note as report() makes it (their runs skipped)
@@ -227,6 +228,7 @@ def test_peers_that_are_not_installed_are_said_skipped(tmp_path, monkeypatch):
     report_card.write(card, tmp_path)
     said = "MuJoCo RK4, MuJoCo Euler: not installed: rows skipped"
     assert said in (tmp_path / "report.md").read_text(encoding="utf-8")
+    assert "heyoka: not installed: row skipped" in (tmp_path / "report.md").read_text("utf-8")
     assert said in (tmp_path / "report.html").read_text(encoding="utf-8")
 
 
@@ -352,3 +354,25 @@ def test_clicking_a_legend_entry_hides_the_methods_curves(page):
     after = len(page.find_elements(By.CSS_SELECTOR, f"#{DIV_ID} .scatterlayer .trace"))
     assert after == drawn - 4  # its four curves are gone from the drawing
     assert severe(page) == []
+
+
+def test_heyoka_is_a_row_or_is_said_skipped(monkeypatch):
+    from tumble.report_card import peers
+
+    names = [row.name for row in report_card.rows(["rkmk4"])]
+    if peers.heyoka_available():
+        assert "heyoka" in names and "heyoka" not in report_card.skipped_peers(True)
+        row = next(row for row in report_card.rows(["rkmk4"]) if row.name == "heyoka")
+        # its declared order is the one heyoka itself gives its Taylor method there
+        p1 = report_card.problems()[0]
+        ta = peers._heyoka_integrator(p1, peers.HEYOKA_FIXED_TOL)
+        assert row.order == ta.order == 6
+        # heyoka's system is the card's rhs: the forced body's y(T) agrees with scipy's
+        forced = report_card.problems()[-1]
+        run = peers.run_row(row, forced, 1e-12)
+        assert run.ok
+        assert report_card.attitude_error(run.R_end, report_card.reference(forced)) < 1e-9
+    monkeypatch.setattr(peers, "heyoka_available", lambda: False)
+    assert "heyoka" not in [row.name for row in report_card.rows(["rkmk4"])]
+    said = report_card.skipped_peers(True)["heyoka"]
+    assert said.startswith("not installed: row skipped")

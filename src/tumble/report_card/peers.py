@@ -2,7 +2,8 @@
 
 A row is a tumble method of :data:`tumble.rigid.METHODS` (what it declares, read from its
 :class:`~tumble.rigid.Method`) or a peer: scipy's ``DOP853`` and ``RK45`` on Euler's equations
-with a quaternion, MuJoCo's ``RK4`` and ``Euler`` when the ``bench`` extra is installed.
+with a quaternion, MuJoCo's ``RK4`` and ``Euler`` and heyoka's Taylor integrator (Euler's
+equations with a quaternion, compiled by LLVM) when the ``bench`` extra is installed.
 :func:`run_row` runs any of them on a problem and returns what it left (:class:`Sampled`).
 """
 
@@ -38,7 +39,7 @@ class Row:
     """
 
     name: str
-    source: str  # "tumble", "scipy", "MuJoCo"
+    source: str  # "tumble", "scipy", "MuJoCo", "heyoka"
     order: float
     adaptive: bool
     claims: frozenset[str]
@@ -68,12 +69,43 @@ MUJOCO_ROWS = ("MuJoCo RK4", "MuJoCo Euler")
 """The peer rows MuJoCo gives when it is installed."""
 
 
+def heyoka_available() -> bool:
+    """Whether heyoka (the ``bench`` extra) can be imported."""
+    try:
+        import heyoka  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+HEYOKA_ROW = "heyoka"
+"""The peer row heyoka gives when it is installed."""
+HEYOKA_FIXED_TOL = 1e-4
+"""heyoka's tolerance where the card measures its order (at fixed steps,
+:func:`fixed_step_end`), where its Taylor order is
+:func:`taylor_order` (6); its own steps there are longer than the card's finer fixed ones."""
+
+
+def taylor_order(tol: float) -> int:
+    """The order heyoka gives its Taylor method at tolerance ``tol``: ``⌈−ln(tol)/2 + 1⌉``
+    (Jorba–Zou's choice, which heyoka's ``taylor_adaptive.order`` reports)."""
+    return math.ceil(-math.log(tol) / 2.0 + 1.0)
+
+
 def skipped_peers(peers: bool = True) -> dict[str, str]:
-    """The peer rows :func:`rows` leaves out, each with why (MuJoCo not installed)."""
-    if not peers or mujoco_available():
+    """The peer rows :func:`rows` leaves out, each with why (MuJoCo or heyoka not installed)."""
+    if not peers:
         return {}
-    why = "not installed: rows skipped (MuJoCo is in the bench extra: pip install -e '.[bench]')"
-    return dict.fromkeys(MUJOCO_ROWS, why)
+    skipped: dict[str, str] = {}
+    if not mujoco_available():
+        why = (
+            "not installed: rows skipped (MuJoCo is in the bench extra: pip install -e '.[bench]')"
+        )
+        skipped |= dict.fromkeys(MUJOCO_ROWS, why)
+    if not heyoka_available():
+        skipped[HEYOKA_ROW] = ("not installed: row skipped (heyoka is in the bench extra: "
+                               "pip install -e '.[bench]')")  # fmt: skip
+    return skipped
 
 
 def rows(methods: Iterable[str] | None = None, *, peers: bool = True) -> list[Row]:
@@ -90,6 +122,9 @@ def rows(methods: Iterable[str] | None = None, *, peers: bool = True) -> list[Ro
                 Row("MuJoCo RK4", "MuJoCo", 4.0, False, frozenset(), "quat", takes_loads=False),
                 Row("MuJoCo Euler", "MuJoCo", 1.0, False, frozenset(), "quat", takes_loads=False),
             ]
+        if heyoka_available():
+            found.append(Row(HEYOKA_ROW, "heyoka", float(taylor_order(HEYOKA_FIXED_TOL)), True,
+                             frozenset(), "quat, Taylor (LLVM)"))  # fmt: skip
     return found
 
 
@@ -164,6 +199,85 @@ def _scipy_run(method: str, problem: CardProblem, rtol: float, t_end: float) -> 
                    int(solution.t.size - 1), seconds, bool(solution.success))  # fmt: skip
 
 
+_HEYOKA_INTEGRATORS: dict = {}
+"""heyoka's integrators by (problem, tol): each is compiled by LLVM once (0.1–0.5 s), outside
+the timed runs, as a user keeps one."""
+
+
+def _heyoka_integrator(problem: CardProblem, tol: float):
+    """``taylor_adaptive`` for Euler's equations and the quaternion of :func:`rhs` (the
+    dipole's body torque ``μ × Rᵀ B``), built once per problem and tolerance."""
+    key = (problem.name, tol)
+    if key in _HEYOKA_INTEGRATORS:
+        return _HEYOKA_INTEGRATORS[key]
+    import heyoka as hy
+
+    w1, w2, w3, q0, q1, q2, q3 = hy.make_vars("w1", "w2", "w3", "q0", "q1", "q2", "q3")
+    A, B, C = problem.body.inertia.diagonal()
+    torque = [0.0, 0.0, 0.0]
+    if problem.dipole is not None:
+        mu, field = problem.dipole.moment, problem.dipole.field
+        R = [
+            [1 - 2 * (q2 * q2 + q3 * q3), 2 * (q1 * q2 - q0 * q3), 2 * (q1 * q3 + q0 * q2)],
+            [2 * (q1 * q2 + q0 * q3), 1 - 2 * (q1 * q1 + q3 * q3), 2 * (q2 * q3 - q0 * q1)],
+            [2 * (q1 * q3 - q0 * q2), 2 * (q2 * q3 + q0 * q1), 1 - 2 * (q1 * q1 + q2 * q2)],
+        ]
+        b = [sum(R[i][j] * float(field[i]) for i in range(3) if field[i] != 0.0)
+             for j in range(3)]  # Rᵀ B  # fmt: skip
+        m = [float(v) for v in mu]
+        torque = [m[1] * b[2] - m[2] * b[1], m[2] * b[0] - m[0] * b[2], m[0] * b[1] - m[1] * b[0]]
+    system = [
+        (w1, ((B - C) * w2 * w3 + torque[0]) / A),
+        (w2, ((C - A) * w3 * w1 + torque[1]) / B),
+        (w3, ((A - B) * w1 * w2 + torque[2]) / C),
+        (q0, 0.5 * (-q1 * w1 - q2 * w2 - q3 * w3)),
+        (q1, 0.5 * (q0 * w1 + q2 * w3 - q3 * w2)),
+        (q2, 0.5 * (q0 * w2 + q3 * w1 - q1 * w3)),
+        (q3, 0.5 * (q0 * w3 + q1 * w2 - q2 * w1)),
+    ]
+    ta = hy.taylor_adaptive(system, y0(problem), tol=tol)
+    _HEYOKA_INTEGRATORS[key] = ta
+    return ta
+
+
+def _heyoka_run(problem: CardProblem, tol: float, t_end: float, samples: int) -> Sampled:
+    """heyoka's ``taylor_adaptive`` at ``tol`` (its one tolerance, absolute and relative);
+    samples by ``propagate_grid``, the ends alone by ``propagate_until``."""
+    import heyoka as hy
+
+    ta = _heyoka_integrator(problem, tol)
+    ta.time = 0.0
+    ta.state[:] = y0(problem)
+    start = time.perf_counter()
+    if samples:
+        t = np.linspace(0.0, t_end, samples + 1)
+        outcome, _, _, steps, *_, states = ta.propagate_grid(t)
+    else:
+        outcome, _, _, steps, *_ = ta.propagate_until(t_end)
+        t, states = np.array([0.0, t_end]), np.array([y0(problem), ta.state.copy()])
+    seconds = time.perf_counter() - start
+    ok = outcome == hy.taylor_outcome.time_limit and bool(np.all(np.isfinite(states)))
+    q, omega = states[:, 3:], states[:, :3]
+    R = so3.matrix_from_quat(q)  # normalised, as scipy's rows are read
+    casimir = np.linalg.norm(omega * problem.body.inertia.diagonal(), axis=1)
+    return Sampled(t, R[-1], _peer_energy(problem, omega, R), casimir, 0.0,
+                   float(np.max(np.abs(np.linalg.norm(q, axis=1) - 1.0))), int(steps), seconds,
+                   ok)  # fmt: skip
+
+
+def _heyoka_fixed_end(problem: CardProblem, h: float) -> np.ndarray:
+    """R(T) of heyoka's Taylor method of order :func:`taylor_order` (at
+    :data:`HEYOKA_FIXED_TOL`) stepped at ``h``: each ``step(max_delta_t)`` takes the smaller of
+    ``h`` and its own step (larger than the card's finer steps)."""
+    ta = _heyoka_integrator(problem, HEYOKA_FIXED_TOL)
+    ta.time = 0.0
+    ta.state[:] = y0(problem)
+    n = max(1, round(problem.t_end / h))
+    for k in range(1, n + 1):
+        ta.step(max_delta_t=k * problem.t_end / n - ta.time)
+    return so3.matrix_from_quat(ta.state[3:])
+
+
 def _mujoco_model(problem: CardProblem, integrator: str, h: float):
     """One free-joint body, gravity off; the inertia set after compiling (MuJoCo's compiler
     refuses P1's, which breaks the triangle inequality), as in benchmarks/bench_rigid.py."""
@@ -224,6 +338,8 @@ def run_row(row: Row, problem: CardProblem, setting: float, *, t_end: float | No
             return _tumble_run(row, problem, setting, t_end, samples)
         if row.source == "scipy":
             return _scipy_run(row.name.split()[-1], problem, setting, t_end)
+        if row.source == "heyoka":
+            return _heyoka_run(problem, setting, t_end, samples)
         return _mujoco_run(row.name.split()[-1], problem, setting, t_end, samples)
 
 
@@ -233,8 +349,10 @@ def fixed_step_end(row: Row, problem: CardProblem, h: float) -> np.ndarray:
     A tumble method: its own stepper (what ``simulate`` builds, :func:`_fixed_step_stepper`)
     handed to :func:`tumble.ode.march` with no :class:`~tumble.ode.driver.Control`, so every
     step is taken at ``h``; scipy: ``solve_ivp`` with ``first_step = max_step = h`` and
-    tolerances too loose to reject a step.
+    tolerances too loose to reject a step; heyoka: :func:`_heyoka_fixed_end`.
     """
+    if row.source == "heyoka":
+        return _heyoka_fixed_end(problem, h)
     if row.source == "scipy":
         from scipy.integrate import solve_ivp
 
