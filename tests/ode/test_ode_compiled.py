@@ -1,4 +1,6 @@
-"""solve with a numba-compiled right-hand side runs compiled and gives the Python path's result.
+"""solve's compiled loops give the Python path's result (``compiled=False``: every step in
+Python), with a numba-compiled right-hand side called directly and with a Python one called
+back (``RHS``: both).
 
 The fixed-step runs differ only in the order of their stage sums: the compiled loop adds in
 its own order, numpy's ``@`` in the order of the CPU's BLAS kernel (with or without FMA). Each
@@ -45,6 +47,19 @@ def van_der_pol_python(t, y):
 @numba.njit(cache=True)
 def blow_up(t, y):
     return y * y  # y = 1 / (1 - t): infinite at t = 1
+
+
+RHS = pytest.mark.parametrize("rhs", ["numba", "python"])
+"""The compiled runs: a numba ``fun``, and a Python one called back from the loops."""
+
+
+def _fun(rhs):
+    return van_der_pol if rhs == "numba" else van_der_pol_python
+
+
+def _both(rhs):
+    """(the compiled run's fun and compiled flag, the Python path's)."""
+    return ((_fun(rhs), True), (van_der_pol_python, False))
 
 
 def position(t, y):
@@ -117,11 +132,20 @@ def _assert_same(method, compiled, python):
         assert np.all(np.abs(ours - theirs) <= EVENT_XTOL * (1 + np.abs(theirs)) + near / speed)
 
 
+@RHS
 @pytest.mark.parametrize("method", TABLEAUX)
-def test_compiled_solve_equals_the_python_path_with_dense_output_and_events(method):
+def test_compiled_solve_equals_the_python_path_with_dense_output_and_events(method, rhs):
     runs = [
-        solve(fun, (0, 8), [2, 0], events=position, dense_output=True, **_options(method))
-        for fun in (van_der_pol, van_der_pol_python)
+        solve(
+            fun,
+            (0, 8),
+            [2, 0],
+            events=position,
+            dense_output=True,
+            compiled=compiled,
+            **_options(method),
+        )  # fmt: skip
+        for fun, compiled in _both(rhs)
     ]
     _assert_same(method, *runs)
     assert len(runs[0].t_events[0]) == 2  # Van der Pol crosses y = 0 at t ≈ 2.9 and 6.7
@@ -130,19 +154,31 @@ def test_compiled_solve_equals_the_python_path_with_dense_output_and_events(meth
     np.testing.assert_allclose(runs[0].sol(between), runs[1].sol(between), rtol=0, atol=near)
 
 
+@RHS
 @pytest.mark.parametrize("method", ["rk8", "dopri5"])
-def test_compiled_solve_stops_at_a_terminal_event_as_the_python_path(method):
+def test_compiled_solve_stops_at_a_terminal_event_as_the_python_path(method, rhs):
     runs = [
-        solve(fun, (0, 100), [2, 0], events=_terminal(3), dense_output=True, **_options(method))
-        for fun in (van_der_pol, van_der_pol_python)
+        solve(
+            fun,
+            (0, 100),
+            [2, 0],
+            events=_terminal(3),
+            dense_output=True,
+            compiled=compiled,
+            **_options(method),
+        )  # fmt: skip
+        for fun, compiled in _both(rhs)
     ]
     _assert_same(method, *runs)
     assert runs[0].status == 1 and runs[0].y[0, -1] == pytest.approx(0.0, abs=1e-9)
     assert runs[0].sol.t_max == runs[0].t[-1] < 100
 
 
-def test_compiled_fixed_step_run_reports_a_non_finite_state_as_the_python_path():
-    runs = [solve(fun, (0, 2), [1.0], method="rk4", h=0.125) for fun in (blow_up, blow_up.py_func)]
+@RHS
+def test_compiled_fixed_step_run_reports_a_non_finite_state_as_the_python_path(rhs):
+    fun = blow_up if rhs == "numba" else blow_up.py_func
+    runs = [solve(f, (0, 2), [1.0], method="rk4", h=0.125, compiled=compiled)
+            for f, compiled in ((fun, True), (blow_up.py_func, False))]  # fmt: skip
     assert runs[0].status == -1 and runs[0].message == runs[1].message
     assert "non-finite" in runs[0].message
     np.testing.assert_array_equal(runs[0].t, runs[1].t)
@@ -151,25 +187,30 @@ def test_compiled_fixed_step_run_reports_a_non_finite_state_as_the_python_path()
     # its stage sums (s + 2, on positive terms): d_{n+1} = g_n d_n + 6 eps.
     rtol = 0.0
     for y in runs[1].y[0, :-1]:
-        up, down = (solve(blow_up.py_func, (0, 0.125), [y * (1 + d)], h=0.125).y[0, -1]
+        up, down = (solve(blow_up.py_func, (0, 0.125), [y * (1 + d)], h=0.125,
+                          compiled=False).y[0, -1]
                     for d in (1e-7, -1e-7))  # fmt: skip
         rtol = (np.log(up / down) / 2e-7) * rtol + 6 * EPS
     np.testing.assert_allclose(runs[0].y, runs[1].y, rtol=rtol, atol=0)
 
 
-def test_compiled_adaptive_run_stops_at_the_minimum_step_as_the_python_path():
-    runs = [solve(fun, (0, 2), [1.0], method="dopri5") for fun in (blow_up, blow_up.py_func)]
+@RHS
+def test_compiled_adaptive_run_stops_at_the_minimum_step_as_the_python_path(rhs):
+    fun = blow_up if rhs == "numba" else blow_up.py_func
+    runs = [solve(f, (0, 2), [1.0], method="dopri5", compiled=compiled)
+            for f, compiled in ((fun, True), (blow_up.py_func, False))]  # fmt: skip
     assert runs[0].status == runs[1].status == -1
     assert "minimum" in runs[0].message and "minimum" in runs[1].message
     assert runs[0].n_steps == runs[1].n_steps
     assert runs[0].t[-1] == pytest.approx(1.0, abs=1e-3)  # the pole of 1 / (1 - t)
 
 
+@RHS
 @pytest.mark.parametrize("method", ["rk4", "dopri5"])
-def test_compiled_run_stops_after_max_steps_as_the_python_path(method):
+def test_compiled_run_stops_after_max_steps_as_the_python_path(method, rhs):
     runs = [
-        solve(fun, (0, 6), [2, 0], max_steps=7, **_options(method))
-        for fun in (van_der_pol, van_der_pol_python)
+        solve(fun, (0, 6), [2, 0], max_steps=7, compiled=compiled, **_options(method))
+        for fun, compiled in _both(rhs)
     ]
     assert runs[0].status == -1 and runs[0].n_steps == runs[1].n_steps == 7
     assert runs[0].message.split(" at t=")[0] == runs[1].message.split(" at t=")[0]
@@ -191,6 +232,7 @@ def test_compiled_solve_takes_no_step_in_python_with_events_and_dense_output(met
     options = _options(method)
     _python_steps_forbidden(monkeypatch)
     with pytest.raises(AssertionError, match="in Python"):  # the Python path steps there
-        solve(van_der_pol_python, (0, 1), [2, 0], **options)
-    run = solve(van_der_pol, (0, 8), [2, 0], events=position, dense_output=True, **options)
-    assert run.status == 0 and len(run.t_events[0]) == 2 and run.sol is not None
+        solve(van_der_pol_python, (0, 1), [2, 0], compiled=False, **options)
+    for fun in (van_der_pol, van_der_pol_python):
+        run = solve(fun, (0, 8), [2, 0], events=position, dense_output=True, **options)
+        assert run.status == 0 and len(run.t_events[0]) == 2 and run.sol is not None

@@ -60,9 +60,11 @@ from typing import NamedTuple
 
 import numba
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.extending import overload
 
 from tumble.ode import control, templates
+from tumble.ode.callback import Callback, PythonRightHandSide, call_address
 from tumble.ode.contract import FAILURES, NON_FINITE, OK
 from tumble.ode.dense import StepInterpolant
 from tumble.ode.driver import AdaptiveBlock, Block, Compiled, Control, Grid, Steps
@@ -75,6 +77,84 @@ FIRST_BLOCK, LARGEST_BLOCK = 256, 1 << 16
 """An adaptive block has room for this many steps, doubling at each block up to the second."""
 
 _INITIAL_STEP = njit(**_INLINE)(control.initial_step)
+
+
+def _is_callback(fun) -> bool:
+    """Whether the numba type ``fun`` is a :class:`~tumble.ode.callback.Callback` (a Python
+    right-hand side), not a compiled function."""
+    return isinstance(fun, types.BaseNamedTuple) and fun.instance_class is Callback
+
+
+def _evaluate(fun, t, z, X, i):
+    """``X[i] = fun(t, z)``: a compiled ``fun`` called directly, a Python one through its
+    :class:`~tumble.ode.callback.Callback` (``z`` into its ``z``, the call, its ``out`` into
+    ``X[i]``; NaN when ``fun`` raised)."""
+
+
+def _evaluate_into(fun, t, z, f):
+    """``f[:] = fun(t, z)``: :func:`_evaluate` into a vector."""
+
+
+def _initial(fun, t, y, f, order, rtol, atol):
+    """:func:`tumble.ode.control.initial_step` for a compiled ``fun``; a Python one has its
+    first step chosen by ``solve`` in Python (NaN here, never asked)."""
+
+
+@overload(_evaluate, inline="always", jit_options=_JIT)
+def _evaluate_overload(fun, t, z, X, i):
+    if _is_callback(fun):
+
+        def through_callback(fun, t, z, X, i):
+            shared = fun.z
+            for q in range(z.shape[0]):
+                shared[q] = z[q]
+            if call_address(fun.address, t) == 0:
+                X[i, :] = fun.out
+            else:
+                X[i, :] = np.nan
+
+        return through_callback
+
+    def direct(fun, t, z, X, i):
+        X[i, :] = fun(t, z)
+
+    return direct
+
+
+@overload(_evaluate_into, inline="always", jit_options=_JIT)
+def _evaluate_into_overload(fun, t, z, f):
+    if _is_callback(fun):
+
+        def through_callback(fun, t, z, f):
+            shared = fun.z
+            for q in range(z.shape[0]):
+                shared[q] = z[q]
+            if call_address(fun.address, t) == 0:
+                f[:] = fun.out
+            else:
+                f[:] = np.nan
+
+        return through_callback
+
+    def direct(fun, t, z, f):
+        f[:] = fun(t, z)
+
+    return direct
+
+
+@overload(_initial, inline="always", jit_options=_JIT)
+def _initial_overload(fun, t, y, f, order, rtol, atol):
+    if _is_callback(fun):
+
+        def unasked(fun, t, y, f, order, rtol, atol):
+            return np.nan
+
+        return unasked
+
+    def initial(fun, t, y, f, order, rtol, atol):
+        return _INITIAL_STEP(fun, t, y, f, order, rtol, atol)
+
+    return initial
 
 
 class Tableau:
@@ -238,7 +318,7 @@ def _stages(problem, y, f, X, z, t, h):
     X[0] = f
     for i in range(1, A.shape[0]):
         _stage_point(A, i, i, y, h, X, z)
-        X[i, :] = fun(t + c[i] * h, z)
+        _evaluate(fun, t + c[i] * h, z, X, i)
 
 
 @njit(**_INLINE)
@@ -252,7 +332,7 @@ def _extend(problem, y, y_new, f_new, X, z, t, h):
     X[s] = f_new
     for j in range(dense_c.shape[0]):
         _stage_point(dense_A, j, s + 1 + j, y, h, X, z)
-        X[s + 1 + j, :] = fun(t + dense_c[j] * h, z)
+        _evaluate(fun, t + dense_c[j] * h, z, X, s + 1 + j)
     if problem.hermite:
         _slopes(y, y_new, h, z)
 
@@ -291,7 +371,7 @@ def _fixed_step(problem, state, work, t, t_new, settle):
     _stages(problem, y, f, X, z, t, h)
     if not _combine(b, e, y, h, X, y_new, err):
         return NON_FINITE
-    f[:] = problem.fun(t_new, y_new)
+    _evaluate_into(problem.fun, t_new, y_new, f)
     _extend(problem, y, y_new, f, X, z, t, h)
     y[:] = y_new
     return OK
@@ -330,7 +410,7 @@ def _accept(problem, state, work, t, t_new, fsal):
     if fsal:
         f[:] = X[s - 1]
     else:
-        f[:] = problem.fun(t_new, y_new)
+        _evaluate_into(problem.fun, t_new, y_new, f)
     _extend(problem, y, y_new, f, X, z, t, t_new - t)
     y[:] = y_new
     return False
@@ -340,7 +420,7 @@ def _accept(problem, state, work, t, t_new, fsal):
 def _first_step(problem, state, work, t):
     """:func:`tumble.ode.control.initial_step` (one evaluation), as solve's Python path."""
     y, f = state
-    return _INITIAL_STEP(problem.fun, t, y, f, problem.order, problem.rtol, problem.atol)
+    return _initial(problem.fun, t, y, f, problem.order, problem.rtol, problem.atol)
 
 
 _FIXED = templates.loop(
@@ -356,6 +436,19 @@ _ADAPTIVE = templates.loop(
 )  # fmt: skip
 """``solve``'s adaptive steps: :func:`tumble.ode.templates.adaptive_loop` with the tries
 above."""
+
+_PYTHON_FIXED = templates.loop(
+    templates.fixed_loop, "_solve_python_fixed", WORK=_work, STEP=_fixed_step, RECORD=_record,
+)  # fmt: skip
+""":data:`_FIXED` for a Python right-hand side (a :class:`~tumble.ode.callback.Callback` in
+the problem: no function in the types, so one compilation, cached on disk, serves every
+Python ``fun``)."""
+
+_PYTHON_ADAPTIVE = templates.loop(
+    templates.adaptive_loop, "_solve_python_adaptive", WORK=_adaptive_work, TRY=_try,
+    FINITE=_finite, ACCEPT=_accept, FIRST_STEP=_first_step, RECORD=_adaptive_record,
+)  # fmt: skip
+""":data:`_ADAPTIVE` for a Python right-hand side."""
 
 
 _ENTRIES: dict[int, tuple[weakref.ref, dict]] = {}
@@ -408,10 +501,17 @@ class CompiledRungeKutta(RungeKutta):
         ``steps``): for events and dense output, which then stay compiled.
     """
 
-    def __init__(self, fun: Callable, compiled: Callable, tableau: ButcherTableau, t0: float,
-                 y0: np.ndarray, *, interpolants: bool):  # fmt: skip
+    def __init__(self, fun: Callable, compiled: Callable | None, tableau: ButcherTableau,
+                 t0: float, y0: np.ndarray, *, interpolants: bool):  # fmt: skip
         super().__init__(fun, tableau, t0, y0)
-        self.jitted, self.tab = compiled, _tableau(tableau)
+        self.python: PythonRightHandSide | None = None
+        if compiled is None:  # a Python right-hand side, called back from the loops
+            self.python = PythonRightHandSide(getattr(fun, "fun", fun), y0.size)
+            self.jitted: Callable | Callback = self.python.callback
+            self._loops, self._key = (_PYTHON_FIXED, _PYTHON_ADAPTIVE), Callback
+        else:
+            self.jitted, self._loops, self._key = compiled, (_FIXED, _ADAPTIVE), compiled
+        self.tab = _tableau(tableau)
         self.interpolants = interpolants
         self._problem: SolveProblem | None = None  # the fixed loop's, at its first block
         self.f = np.array(self.f, dtype=float)  # updated in place by the loops
@@ -435,8 +535,10 @@ class CompiledRungeKutta(RungeKutta):
         if self._problem is None:
             self._problem = _new(SolveProblem, (self.jitted, self.tab.arrays, self.tab.hermite,
                                                 self.interpolants))  # fmt: skip
-        count, failed, _ = _call(_FIXED, self.jitted, (
+        count, failed, _ = _call(self._loops[0], self._key, (
             self._problem, grid_tuple, (y, self.f), k0, k1, 1, 0, out))  # fmt: skip
+        if self.python is not None:
+            self.python.reraise()
         tab, start = self.tab, self.compiled_evaluations
         per_step = tab.stages + (tab.extra_stages if self.interpolants else 0)
         self._counts = (start, per_step, 0, _NONE)  # _count
@@ -458,8 +560,10 @@ class CompiledRungeKutta(RungeKutta):
         args = (problem, float(t), float(t1), float(h), settings, tab.fsal, (y, self.f), 1, 0,
                 float(max_steps), out)  # fmt: skip
         count, t_end, h_next, _, rejected, code, t_failed, finite = _call(
-            _ADAPTIVE, self.jitted, args
+            self._loops[1], self._key, args
         )
+        if self.python is not None:
+            self.python.reraise()
         accept = (0 if tab.fsal else 1) + (tab.extra_stages if self.interpolants else 0)
         first = self.compiled_evaluations + (h <= 0.0)  # the first step's choice: one
         self._counts = (first, accept, tab.stages - 1, out.rejected)

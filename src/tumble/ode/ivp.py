@@ -120,14 +120,16 @@ def is_compiled(fun: object) -> bool:
 
 def _stepper(
     counted: _CountedFunction, tableau: ButcherTableau, t0: float, y: np.ndarray,
-    interpolants: bool,
+    interpolants: bool, compiled: bool,
 ) -> RungeKutta:  # fmt: skip
-    """:func:`solve`'s stepper: :class:`RungeKutta`, or its compiled twin
-    (:class:`tumble.ode.compiled.CompiledRungeKutta`) for a compiled ``fun``; each evaluates
+    """:func:`solve`'s stepper: :class:`RungeKutta` with ``compiled=False``, else its
+    compiled twin (:class:`tumble.ode.compiled.CompiledRungeKutta`), which calls a compiled
+    ``fun`` directly and a Python one back (:mod:`tumble.ode.callback`); each evaluates
     ``f(t0, y0)`` through ``counted``, which checks its shape."""
-    if not is_compiled(counted.fun):
+    if not compiled:
         return RungeKutta(counted, tableau, t0, y)
-    return _compiled_stepper()(counted, counted.fun, tableau, t0, y, interpolants=interpolants)
+    jitted = counted.fun if is_compiled(counted.fun) else None
+    return _compiled_stepper()(counted, jitted, tableau, t0, y, interpolants=interpolants)
 
 
 @cache
@@ -197,17 +199,22 @@ def solve(
     atol: float | Sequence[float] = 1e-9,
     events: Event | Sequence[Event] | None = None,
     dense_output: bool = False,
+    t_eval: Sequence[float] | np.ndarray | None = None,
     max_steps: int = 1_000_000,
+    compiled: bool = True,
 ) -> OdeResult:
     """Integrate ``y' = fun(t, y)`` from ``t_span[0]`` to ``t_span[1]``.
 
     Parameters
     ----------
     fun : callable
-        Right-hand side ``fun(t, y) -> ndarray, shape (n,)``. A numba-compiled one
-        (``@numba.njit``, returning a float array) makes the steps compiled
-        (:mod:`tumble.ode.compiled`: the driver marches them in blocks, events and dense
-        output included), with the same result to round-off.
+        Right-hand side ``fun(t, y)`` returning ``n`` numbers (an array, a list or a tuple).
+        The steps run compiled (:mod:`tumble.ode.compiled`: the driver marches them in
+        blocks, events and dense output included), with the result of Python steps to
+        round-off: a numba-compiled ``fun`` (``@numba.njit``, returning a float array) is
+        called from the compiled loop directly, a Python one through a callback
+        (:mod:`tumble.ode.callback`; it is then handed the same array ``y`` at every call,
+        overwritten afterwards: copy it to keep it).
     t_span : (float, float)
         ``(t0, t1)`` with ``t1 > t0``. The last step lands exactly on ``t1``.
     y0 : array_like, shape (n,)
@@ -227,8 +234,14 @@ def solve(
         ``g.direction`` as in ``scipy.integrate.solve_ivp``.
     dense_output : bool
         Return the continuous solution as ``result.sol``.
+    t_eval : array_like, shape (k,), optional
+        Record the solution at these times only (increasing, within ``t_span``), from each
+        step's interpolant, instead of at every accepted step.
     max_steps : int
         Stop with ``status = -1`` after this many accepted steps.
+    compiled : bool
+        False: every step in Python (:class:`RungeKutta`, NumPy per stage), as
+        ``solve_ivp`` does; the same steps and numbers to round-off, several times slower.
 
     Returns
     -------
@@ -268,17 +281,21 @@ def solve(
     max_steps = _checks.count("max_steps", max_steps)
     events = _checks.callables("events", events)
     dense_output = _checks.flag("dense_output", dense_output)
+    times = None if t_eval is None else _checks.sample_times("t_eval", t_eval, t0, t1)
+    compiled = _checks.flag("compiled", compiled)
     counted = _CountedFunction(fun, y.size)
-    stepper = _stepper(counted, tableau, t0, y, bool(events) or dense_output)
+    follows = bool(events) or dense_output or times is not None
+    stepper = _stepper(counted, tableau, t0, y, follows, compiled)
     control = None
     if tableau.adaptive:
         control = Control(float(rtol), atol_array, _CONTROLLER)
-        if h is None and not is_compiled(fun):  # else the compiled adaptive loop chooses it
+        if h is None and not (compiled and is_compiled(fun)):  # else the compiled loop does
             h = initial_step(counted, t0, y, stepper.f, tableau.error_order, rtol, atol_array)
     # Non-finite values are detected and reported as a status, not as numpy warnings.
     with np.errstate(over="ignore", invalid="ignore"):
         out = march(stepper, (t0, t1), y, h=h, control=control, events=events or [],
-                    max_steps=int(max_steps), dense_output=dense_output)  # fmt: skip
+                    max_steps=int(max_steps), dense_output=dense_output,
+                    t_eval=times)  # fmt: skip
     t_events = [np.array(ts, dtype=float) for ts in out.t_events]
     y_events = [np.array(ys, dtype=float).reshape(-1, y.size) for ys in out.y_events]
     sol = None
